@@ -1,0 +1,163 @@
+#include "common.hpp"
+
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+
+#include "dqjulia/estimate.hpp"
+
+namespace dqj::cli {
+namespace {
+
+std::atomic<bool> interruptRequested{false};
+
+extern "C" void onInterrupt(int) { interruptRequested.store(true); }
+
+double nowSeconds() {
+    using namespace std::chrono;
+    return duration<double>(steady_clock::now().time_since_epoch()).count();
+}
+
+std::string formatDuration(double seconds) {
+    const long total = long(seconds + 0.5);
+    char text[32];
+    if (total >= 3600)
+        std::snprintf(text, sizeof text, "%ldh%02ldm", total / 3600, (total / 60) % 60);
+    else if (total >= 60)
+        std::snprintf(text, sizeof text, "%ldm%02lds", total / 60, total % 60);
+    else
+        std::snprintf(text, sizeof text, "%lds", total);
+    return text;
+}
+
+}  // namespace
+
+void installInterruptHandlers() {
+    struct sigaction action {};
+    action.sa_handler = onInterrupt;
+    sigemptyset(&action.sa_mask);
+    sigaction(SIGINT, &action, nullptr);
+    sigaction(SIGTERM, &action, nullptr);
+}
+
+bool interrupted() { return interruptRequested.load(); }
+
+void FractalOptions::addTo(CLI::App& command) {
+    command.add_option("-p,--params", paramsFile, "Parameter file (JSON, see README); flags override its values")
+        ->check(CLI::ExistingFile);
+    command.add_option("--c", constant, "Constant: 8 numbers, a's s i j k then b's s i j k")->expected(8);
+    command.add_option("--variant", variant, "Algebra: paper, paper-coupled or dual")
+        ->check(CLI::IsMember({"paper", "paper-coupled", "dual"}));
+    command.add_option("-n,--iterations", iterations, "Iterations N (1..100000)");
+    command.add_option("--bailout", bailout, "Bailout radius R (at least the containment radius r_K)");
+    command.add_option("--slice", sliceAxes, "Slice axes by name, e.g. a.s,a.i,a.j or a.i,a.j,b.s");
+    command.add_option("--slice-origin", sliceOrigin, "Slice origin: 8 numbers")->expected(8);
+    command.add_option("--rotate", rotations, "Turn the slice: PLANE:DEGREES, e.g. a.j,b.s:30 (repeatable)");
+}
+
+void FractalOptions::applyTo(Params& params) const {
+    if (!constant.empty()) {
+        Vec8 values;
+        std::copy(constant.begin(), constant.end(), values.begin());
+        params.fractal.c = toDualQuat(values);
+    }
+    if (!variant.empty()) params.fractal.variant = *parseVariant(variant);
+    if (iterations) params.fractal.iterations = *iterations;
+    if (bailout) params.fractal.bailout = *bailout;
+    if (!sliceAxes.empty()) {
+        try {
+            const Vec8 origin = params.slice.base.origin;
+            params.slice.base = sliceFromAxisNames(sliceAxes);
+            params.slice.base.origin = origin;
+            params.slice.rotations.clear();
+        } catch (const std::invalid_argument& error) {
+            throw ParamError("slice.axes", std::string("--slice: ") + error.what());
+        }
+    }
+    if (!sliceOrigin.empty()) std::copy(sliceOrigin.begin(), sliceOrigin.end(), params.slice.base.origin.begin());
+    for (const std::string& text : rotations) {
+        const std::size_t colon = text.rfind(':');
+        const std::size_t comma = text.find(',');
+        const auto first = parseAxisName(text.substr(0, std::min(comma, colon)));
+        const auto second = comma < colon ? parseAxisName(text.substr(comma + 1, colon - comma - 1)) : std::nullopt;
+        double degrees = 0.0;
+        bool numberOk = colon != std::string::npos;
+        if (numberOk) {
+            try {
+                std::size_t used = 0;
+                degrees = std::stod(text.substr(colon + 1), &used);
+                numberOk = used == text.size() - colon - 1 && std::isfinite(degrees);
+            } catch (const std::exception&) {
+                numberOk = false;
+            }
+        }
+        if (!first || !second || *first == *second || !numberOk)
+            throw ParamError("slice.rotations", "--rotate \"" + text +
+                                                    "\": expected PLANE:DEGREES with two different axes, e.g. a.j,b.s:30");
+        params.slice.rotations.push_back({*first, *second, degrees});
+    }
+}
+
+Params FractalOptions::load() const {
+    Params params = paramsFile.empty() ? Params{} : loadParams(paramsFile, Validation::TypesOnly);
+    applyTo(params);
+    validate(params);
+    return params;
+}
+
+int reportErrors(const std::string& command, const std::function<int()>& body) {
+    try {
+        return body();
+    } catch (const ParamError& error) {
+        std::cerr << "dqjulia " << command << ": " << error.what() << "\n";
+        return kBadInput;
+    } catch (const Cancelled&) {
+        std::cerr << "dqjulia " << command << ": interrupted; nothing was written\n";
+        return kInterrupted;
+    } catch (const std::exception& error) {
+        std::cerr << "dqjulia " << command << ": " << error.what() << "\n";
+        return kFailure;
+    }
+}
+
+ProgressBar::ProgressBar(std::string label, bool quiet)
+    : label_(std::move(label)), enabled_(!quiet && isatty(STDERR_FILENO)), startSeconds_(nowSeconds()) {}
+
+ProgressBar::~ProgressBar() {
+    if (drawn_) std::cerr << "\n";
+}
+
+ProgressCallback ProgressBar::callback() {
+    return [this](double fraction) { return update(fraction); };
+}
+
+bool ProgressBar::update(double fraction) {
+    if (interrupted()) return false;
+    if (!enabled_) return true;
+    const double now = nowSeconds();
+    if (fraction < 1.0 && now - lastDrawSeconds_ < 0.1) return true;
+    lastDrawSeconds_ = now;
+    const double elapsed = now - startSeconds_;
+    constexpr int kWidth = 30;
+    const int filled = int(fraction * kWidth);
+    std::string bar(filled, '#');
+    bar.resize(kWidth, '.');
+    std::string eta = fraction > 0.02 && fraction < 1.0 ? " ETA " + formatDuration(elapsed / fraction * (1.0 - fraction)) : "";
+    char percent[16];
+    std::snprintf(percent, sizeof percent, "%3d%%", int(fraction * 100.0));
+    std::cerr << "\r" << label_ << " [" << bar << "] " << percent << "  " << formatDuration(elapsed) << eta << "\x1b[K"
+              << std::flush;
+    drawn_ = true;
+    return true;
+}
+
+void ProgressBar::finish() {
+    if (drawn_) std::cerr << "\n";
+    drawn_ = false;
+}
+
+}  // namespace dqj::cli

@@ -1,0 +1,62 @@
+// Shared pieces of the dqjulia command: the fractal options every subcommand takes,
+// loading parameters with flag overrides, errors and the progress bar.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "dqjulia/params.hpp"
+#include "dqjulia/progress.hpp"
+
+namespace dqj::cli {
+
+/// Exit codes: 0 success, 1 failure while working, 2 bad input, 130 interrupted.
+enum ExitCode { kSuccess = 0, kFailure = 1, kBadInput = 2, kInterrupted = 130 };
+
+/// --params and the fractal and slice flags, shared by render, eval and inspect.
+struct FractalOptions {
+    std::string paramsFile;
+    std::vector<double> constant;
+    std::string variant;
+    std::optional<int> iterations;
+    std::optional<double> bailout;
+    std::string sliceAxes;
+    std::vector<double> sliceOrigin;
+    std::vector<std::string> rotations;
+
+    void addTo(CLI::App& command);
+    /// Defaults, then the file, then the flags; validated at the end. Throws ParamError.
+    Params load() const;
+    /// Applies the flags to `params` without validating. Throws ParamError for malformed flags.
+    void applyTo(Params& params) const;
+};
+
+/// Runs `body`, printing "dqjulia: <message>" for errors and returning the exit code.
+int reportErrors(const std::string& command, const std::function<int()>& body);
+
+/// A progress bar with ETA on stderr when it is a terminal (and not quiet); silent otherwise.
+/// Returns false once SIGINT or SIGTERM arrived, which cancels the work.
+class ProgressBar {
+public:
+    ProgressBar(std::string label, bool quiet);
+    ~ProgressBar();
+    ProgressCallback callback();
+    void finish();
+
+private:
+    bool update(double fraction);
+    std::string label_;
+    bool enabled_;
+    double startSeconds_;
+    double lastDrawSeconds_ = -1.0;
+    bool drawn_ = false;
+};
+
+/// Installs SIGINT/SIGTERM handlers that ask running work to stop (see interrupted()).
+void installInterruptHandlers();
+bool interrupted();
+
+}  // namespace dqj::cli

@@ -1,0 +1,128 @@
+/* dqjulia/dqjulia.h - the C ABI of libdqjulia: dual-quaternion Julia fractals.
+ *
+ * The one stable surface of the library, for C programs and for hosts that load it
+ * at run time (the Blender add-on uses it through ctypes).
+ *
+ * - Opaque handles: a dqj_context holds a parameter set and the text of its last error.
+ * - Every call returns a dqj_status; on failure dqj_context_error() tells why. There is
+ *   no global error buffer, and no C++ exception ever crosses this boundary.
+ * - Null pointers and unknown or destroyed handles give DQJ_ERROR_INVALID_HANDLE or
+ *   DQJ_ERROR_INVALID_ARGUMENT, never a crash.
+ * - Buffers are the caller's: sizes are queried first, then filled.
+ *
+ * Thread safety: dqj_version*() and dqj_status_string() may be called from any thread.
+ * Separate contexts are independent and may be used from different threads at the same
+ * time. One context must not be used from two threads at once (calls on it are not
+ * serialised); its progress callback runs on the thread that called dqj_render*().
+ */
+#ifndef DQJULIA_H
+#define DQJULIA_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "dqjulia/export.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* Version of the header you compile against; compare with dqj_version_number() at run time. */
+#define DQJ_VERSION_MAJOR 0
+#define DQJ_VERSION_MINOR 1
+#define DQJ_VERSION_PATCH 0
+#define DQJ_VERSION_NUMBER (DQJ_VERSION_MAJOR * 10000 + DQJ_VERSION_MINOR * 100 + DQJ_VERSION_PATCH)
+
+/* MAJOR*10000 + MINOR*100 + PATCH of the library actually loaded. */
+DQJ_API unsigned dqj_version_number(void);
+/* "0.1.0" */
+DQJ_API const char* dqj_version_string(void);
+
+typedef enum dqj_status {
+    DQJ_OK = 0,
+    DQJ_ERROR_INVALID_HANDLE = 1,   /* null, unknown or destroyed context */
+    DQJ_ERROR_INVALID_ARGUMENT = 2, /* null pointer, size too small, value out of range */
+    DQJ_ERROR_PARAMETERS = 3,       /* parameter file or value rejected; the message names the key */
+    DQJ_ERROR_IO = 4,               /* a file could not be read or written */
+    DQJ_ERROR_CANCELLED = 5,        /* the progress callback asked to stop */
+    DQJ_ERROR_OUT_OF_MEMORY = 6,
+    DQJ_ERROR_INTERNAL = 7
+} dqj_status;
+
+/* A short English name for a status ("invalid handle"); never NULL. */
+DQJ_API const char* dqj_status_string(dqj_status status);
+
+typedef enum dqj_variant {
+    DQJ_VARIANT_PAPER = 0,         /* the paper's rule: a and b iterate independently */
+    DQJ_VARIANT_PAPER_COUPLED = 1, /* the paper's rule with one 8-D norm */
+    DQJ_VARIANT_DUAL = 2           /* the true dual-quaternion algebra */
+} dqj_variant;
+
+typedef struct dqj_context_t* dqj_context;
+
+/* Creates a context holding the default parameters. */
+DQJ_API dqj_status dqj_context_create(dqj_context* out_context);
+/* Destroys a context; NULL is ignored. The handle is invalid afterwards. */
+DQJ_API void dqj_context_destroy(dqj_context context);
+/* The message of the context's last failed call ("" if none). Valid until the next call on
+ * the context. For an invalid handle, a static text saying so. */
+DQJ_API const char* dqj_context_error(dqj_context context);
+/* A warning from the context's last successful call ("" if none): for example why a render
+ * found no surface (the slice is empty, and what to change). */
+DQJ_API const char* dqj_context_warning(dqj_context context);
+
+/* Parameters: the JSON document of the parameter file (see README), whole or in part;
+ * missing keys take their defaults. */
+DQJ_API dqj_status dqj_context_load_params_file(dqj_context context, const char* path);
+DQJ_API dqj_status dqj_context_set_params_json(dqj_context context, const char* json);
+/* The complete parameter document. Writes at most `capacity` bytes including the final NUL;
+ * `*out_size` (if not NULL) receives the size needed including the NUL. Call with
+ * buffer = NULL, capacity = 0 to query the size. */
+DQJ_API dqj_status dqj_context_get_params_json(dqj_context context, char* buffer, size_t capacity, size_t* out_size);
+
+/* Single values; each is validated like the parameter file. c: a's s,i,j,k then b's. */
+DQJ_API dqj_status dqj_context_set_constant(dqj_context context, const double c[8]);
+DQJ_API dqj_status dqj_context_set_variant(dqj_context context, dqj_variant variant);
+DQJ_API dqj_status dqj_context_set_iterations(dqj_context context, int iterations);
+DQJ_API dqj_status dqj_context_set_bailout(dqj_context context, double bailout);
+/* Axis names such as "a.s,a.i,a.j" (origin kept, rotations cleared). */
+DQJ_API dqj_status dqj_context_set_slice_axes(dqj_context context, const char* axes);
+
+/* The result for one point, as math.md specifies. */
+typedef struct dqj_sample {
+    int32_t n;  /* escape iteration; 0 = did not escape within N */
+    double r;   /* norm used for the escape test, at exit */
+    double ra;  /* |a| at exit */
+    double rb;  /* |b| at exit */
+    double de;  /* distance estimate (8-D units); 0 inside, +inf for a zero derivative */
+} dqj_sample;
+
+/* Evaluates `count` 8-D points (8 doubles each, a then b) into `out` (count samples). */
+DQJ_API dqj_status dqj_evaluate_points(dqj_context context, const double* points, size_t count, dqj_sample* out);
+/* Evaluates `count` 3-D points (3 doubles each) mapped through the context's slice. The DE is
+ * in 8-D units; divide by the slice's largest stretch for a 3-D distance. */
+DQJ_API dqj_status dqj_evaluate_slice_points(dqj_context context, const double* points, size_t count, dqj_sample* out);
+
+/* Progress: called with the fraction done (0..1) on the calling thread: with 0 before the work
+ * starts, a few times a second, and with 1 at the end;
+ * return non-zero to cancel (the call then returns DQJ_ERROR_CANCELLED). */
+typedef int (*dqj_progress_fn)(double fraction, void* user_data);
+
+/* Renders into a caller-owned RGBA8 (sRGB) buffer of `height` rows of `stride` bytes
+ * (stride >= 4 * width); width and height override the parameters' render size. */
+DQJ_API dqj_status dqj_render_rgba8(dqj_context context, uint8_t* pixels, uint32_t width, uint32_t height, size_t stride,
+                                    dqj_progress_fn progress, void* user_data);
+/* Renders and writes an image file (.png 8-bit, or as the parameters' output.format says;
+ * .exr with depth and normals). The file appears only when complete. */
+DQJ_API dqj_status dqj_render_to_file(dqj_context context, const char* path, dqj_progress_fn progress, void* user_data);
+
+/* What the constant and slice give: JSON with the equivalent complex constants, Mandelbrot
+ * membership, bounds, inside fraction and, when the slice is empty, the reason. Same
+ * buffer convention as dqj_context_get_params_json. */
+DQJ_API dqj_status dqj_inspect_json(dqj_context context, char* buffer, size_t capacity, size_t* out_size);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* DQJULIA_H */

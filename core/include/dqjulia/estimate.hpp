@@ -1,0 +1,59 @@
+// dqjulia/estimate.hpp - the escape iteration and the distance estimate (math.md).
+//
+// zeta <- zeta^2 + c for at most N iterations with bailout R. Per iteration the
+// derivative(s) are updated from the current state, then the state, then escape
+// is tested. Cost: at most N iterations of two quaternion squares per point.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <string_view>
+
+#include <glm/vec3.hpp>
+
+#include "dqjulia/algebra.hpp"
+#include "dqjulia/export.h"
+
+namespace dqj {
+
+/// What defines the set: constant, algebra, iteration count N and bailout R.
+struct Fractal {
+    DualQuat c{makeQuat(-0.39054, -0.58679, 0.0, 0.0), makeQuat(0.0, 0.5632, 0.0, 0.05)};
+    Variant variant = Variant::Paper;
+    int iterations = 15;
+    double bailout = 4.0;
+};
+
+/// Result of iterating one 8-D point.
+struct Escape {
+    int n = 0;          ///< iteration at which the orbit escaped; 0 = did not escape within N
+    double r = 0.0;     ///< the norm used for the escape test, at exit (paper: max(|a|,|b|))
+    double ra = 0.0;    ///< |a| at exit
+    double rb = 0.0;    ///< |b| at exit
+    double de = 0.0;    ///< distance estimate in 8-D units; 0 inside, +inf for a zero derivative
+    double trap = 0.0;  ///< orbit trap: the smallest |a| along the orbit (for colouring)
+    DualQuat exit;      ///< the state at exit
+};
+
+/// Iterates `start` under the fractal and returns escape count, norms and DE exactly as math.md.
+DQJ_API Escape evaluate(const Fractal& fractal, const DualQuat& start);
+
+/// Only the distance estimate (same as evaluate(...).de).
+DQJ_API double distanceEstimate(const Fractal& fractal, const DualQuat& start);
+
+/// Any quaternion orbit with |q| > r_K(c) = (1 + sqrt(1 + 4|c|)) / 2 escapes.
+DQJ_API double containmentRadius(const Quat& c);
+
+/// The smallest bailout the fractal allows: r_K of each part that takes part in the escape test.
+DQJ_API double minimumBailout(const Fractal& fractal);
+
+/// Gradient of ln|a_n| with respect to the real part of the start point, along three
+/// real-part directions, from the dual part of the true algebra (math.md, "dual"):
+/// with c_b = 0 and b_0 = direction, grad = (a_n . b_n) / |a_n|^2. Exact, no finite differences.
+DQJ_API glm::dvec3 realPartGradient(const Fractal& fractal, const Quat& start, const Quat directions[3]);
+
+DQJ_API std::string_view variantName(Variant variant);
+/// "paper", "paper-coupled" or "dual"; std::nullopt for anything else.
+DQJ_API std::optional<Variant> parseVariant(std::string_view name);
+
+}  // namespace dqj

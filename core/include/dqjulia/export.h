@@ -1,0 +1,18 @@
+/* dqjulia/export.h - symbol visibility for libdqjulia.
+ * The library is built with hidden visibility so that the symbols of its
+ * dependencies (TBB, OpenEXR, OpenVDB) never leak; only what is marked DQJ_API
+ * is exported: the C ABI and the C++ API beside it. */
+#ifndef DQJULIA_EXPORT_H
+#define DQJULIA_EXPORT_H
+
+#if defined(_WIN32)
+#  if defined(DQJ_BUILDING_LIBRARY)
+#    define DQJ_API __declspec(dllexport)
+#  else
+#    define DQJ_API __declspec(dllimport)
+#  endif
+#else
+#  define DQJ_API __attribute__((visibility("default")))
+#endif
+
+#endif

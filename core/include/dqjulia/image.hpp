@@ -1,0 +1,36 @@
+// dqjulia/image.hpp - rendered images and their files: 8-bit sRGB PNG, 16-bit PNG, and EXR
+// with depth and normal passes for compositing.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "dqjulia/export.h"
+#include "dqjulia/params.hpp"
+
+namespace dqj {
+
+/// Row-major, top row first. Colours are linear RGB; files get the sRGB transfer (PNG) or
+/// stay linear (EXR).
+struct Image {
+    int width = 0;
+    int height = 0;
+    std::vector<float> rgba;    ///< 4 per pixel; alpha = fraction of the pixel's samples that hit
+    std::vector<float> depth;   ///< 1 per pixel: distance from the eye to the nearest hit, +inf if none
+    std::vector<float> normal;  ///< 3 per pixel: unit surface normal in slice coordinates, 0 if none
+};
+
+/// Linear [0, 1] to an 8-bit sRGB code (clamped, rounded). The one sRGB encoder of the library.
+DQJ_API std::uint8_t linearToSrgb8(float linear);
+
+/// Writes `image` to `path` in `format`. The file is written to a temporary file in the same
+/// folder and renamed into place, so a failure never leaves a partial file or destroys an
+/// existing one. Throws std::runtime_error naming the path and the cause.
+DQJ_API void writeImage(const Image& image, const std::string& path, ImageFormat format);
+
+/// Reads an 8- or 16-bit PNG into linear RGBA floats (depth and normal stay empty).
+/// Throws std::runtime_error.
+DQJ_API Image readPng(const std::string& path);
+
+}  // namespace dqj

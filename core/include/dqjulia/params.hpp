@@ -1,0 +1,126 @@
+// dqjulia/params.hpp - the parameter set shared by the whole toolkit, and its JSON file format.
+//
+// One format for the CLI, the Blender add-on and the POV-Ray writer. Loading validates
+// every value and throws ParamError naming the key, what was wrong and what is allowed.
+// The schema is documented in README.md ("Parameter file").
+#pragma once
+
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "dqjulia/estimate.hpp"
+#include "dqjulia/export.h"
+#include "dqjulia/slice.hpp"
+
+namespace dqj {
+
+/// The slice as the user wrote it: origin, axes and the rotations applied to the axes.
+struct SliceSpec {
+    Slice base;
+    std::vector<PlaneRotation> rotations;
+    Slice effective() const { return rotated(base, rotations); }
+};
+
+/// A pinhole camera. When `position` is unset the camera frames the bounds from `direction`.
+struct Camera {
+    std::optional<glm::dvec3> position;
+    std::optional<glm::dvec3> target;          ///< default: the centre of the bounds
+    glm::dvec3 direction{0.55, 0.45, 1.0};     ///< from target towards the camera, for auto framing
+    glm::dvec3 up{0.0, 1.0, 0.0};
+    double fovDegrees = 40.0;                  ///< vertical field of view
+};
+
+/// A directional light: `direction` points from the surface towards the light.
+struct Light {
+    glm::dvec3 direction{1.0, 1.0, 1.0};
+    glm::dvec3 color{1.0, 1.0, 1.0};
+    double intensity = 1.0;
+};
+
+enum class Coloring { Solid, Iterations, Trap };
+
+/// Phong material (the paper's equation) plus occlusion, shadows and orbit colouring.
+struct Material {
+    glm::dvec3 color{0.85, 0.62, 0.35};  ///< base colour (linear RGB) for solid colouring
+    Coloring coloring = Coloring::Trap;
+    std::vector<glm::dvec3> palette{{0.95, 0.75, 0.40}, {0.80, 0.30, 0.20}, {0.20, 0.25, 0.55}};
+    double ambient = 0.15;    ///< k_a
+    double diffuse = 0.8;     ///< k_d
+    double specular = 0.35;   ///< k_s
+    double shininess = 24.0;  ///< specular exponent s
+    double occlusion = 0.8;   ///< strength of ambient occlusion from the DE, 0 = off
+    bool shadows = true;
+    double shadowSoftness = 12.0;  ///< penumbra factor k: larger = harder shadows
+};
+
+enum class NormalMethod { Auto, CentralDifferences, Analytic };
+
+struct RenderSettings {
+    int width = 640;
+    int height = 480;
+    int samples = 2;           ///< anti-aliasing: samples x samples rays per pixel
+    double stepFactor = 0.9;   ///< fraction of the distance estimate taken per step
+    double maxStep = 0.25;     ///< largest step, in slice units
+    int maxSteps = 400;
+    double detail = 1.0;       ///< hit threshold in pixel footprints (smaller = finer)
+    NormalMethod normals = NormalMethod::Auto;  ///< auto: analytic for dual, central differences otherwise
+    glm::dvec3 backgroundTop{0.30, 0.36, 0.45};
+    glm::dvec3 backgroundBottom{0.06, 0.06, 0.08};
+};
+
+enum class ImageFormat { Png8, Png16, Exr };
+
+struct OutputSettings {
+    std::string path = "out/dqjulia.png";
+    std::optional<ImageFormat> format;  ///< default: from the file extension
+};
+
+struct Params {
+    std::string description;  ///< free text, kept on round trips (examples say what they show)
+    Fractal fractal;
+    SliceSpec slice;
+    std::optional<Bounds> bounds;  ///< default: containingBounds(fractal, slice)
+    Camera camera;
+    std::vector<Light> lights{Light{{0.6, 0.8, 0.7}, {1.0, 0.96, 0.9}, 1.0},
+                              Light{{-0.7, 0.2, -0.5}, {0.55, 0.65, 0.9}, 0.35}};
+    Material material;
+    RenderSettings render;
+    OutputSettings output;
+};
+
+/// A bad parameter: `key` is the dotted path ("fractal.iterations"), `what()` the full message.
+class DQJ_API ParamError : public std::runtime_error {
+public:
+    ParamError(std::string key, const std::string& message);
+    const std::string& key() const { return key_; }
+
+private:
+    std::string key_;
+};
+
+enum class Validation { Full, TypesOnly };
+
+/// Parses a parameter document: types, ranges and key names always; the cross-field rules of
+/// validate() too unless `validation` is TypesOnly (for callers that override values first,
+/// such as the CLI's flags, and validate afterwards). `source` names the document in messages.
+/// Missing keys keep their defaults. Throws ParamError.
+DQJ_API Params parseParams(const std::string& jsonText, const std::string& source = "parameters",
+                           Validation validation = Validation::Full);
+/// Reads and parses a file. Throws ParamError (also for a missing or unreadable file).
+DQJ_API Params loadParams(const std::string& path, Validation validation = Validation::Full);
+/// The complete document for `params` (every key written), which parseParams reads back.
+DQJ_API std::string toJson(const Params& params);
+/// Checks the cross-field rules (bailout >= r_K, non-degenerate slice, camera, ...). Throws ParamError.
+DQJ_API void validate(const Params& params);
+
+DQJ_API std::string_view coloringName(Coloring coloring);
+DQJ_API std::string_view normalMethodName(NormalMethod method);
+DQJ_API std::string_view imageFormatName(ImageFormat format);
+/// The format for a path: from `output.format` if set, else from its extension (.png, .exr).
+DQJ_API ImageFormat formatFor(const OutputSettings& output);
+
+}  // namespace dqj

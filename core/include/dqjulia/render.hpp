@@ -1,0 +1,58 @@
+// dqjulia/render.hpp - the sphere-tracing renderer.
+//
+// Rays start where they enter the bounding sphere (radius r_K, math.md) and step by
+// stepFactor * min(DE / stretch, maxStep) until the DE falls below the pixel footprint
+// (times `detail`). Shading: Phong (the paper's equation, several lights), ambient
+// occlusion and soft shadows from the DE, orbit colouring, background gradient,
+// samples x samples anti-aliasing. Work is split in tiles over TBB threads.
+// Cost: about width * height * samples^2 * (steps per ray) * N quaternion iterations.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include <glm/vec3.hpp>
+
+#include "dqjulia/export.h"
+#include "dqjulia/image.hpp"
+#include "dqjulia/params.hpp"
+#include "dqjulia/progress.hpp"
+
+namespace dqj {
+
+/// The camera resolved against the bounds: eye, orthonormal frame and field of view.
+struct CameraFrame {
+    glm::dvec3 eye{0.0};
+    glm::dvec3 forward{0.0, 0.0, -1.0};
+    glm::dvec3 right{1.0, 0.0, 0.0};
+    glm::dvec3 up{0.0, 1.0, 0.0};
+    double tanHalfFov = 0.36;
+    int width = 1;
+    int height = 1;
+    /// Unit direction of the ray through image position (px, py) in pixels, (0,0) = top-left corner.
+    DQJ_API glm::dvec3 rayDirection(double px, double py) const;
+};
+
+/// The bounds the renderer uses: params.bounds if set, else containingBounds(). Throws
+/// ParamError if the slice misses the containment region and no bounds are set.
+DQJ_API Bounds renderBounds(const Params& params);
+DQJ_API CameraFrame frameCamera(const Params& params, const Bounds& bounds);
+
+struct RenderStats {
+    std::uint64_t rays = 0;
+    std::uint64_t steps = 0;      ///< sphere-tracing steps over all rays
+    std::uint64_t hitPixels = 0;  ///< pixels with at least one sample on the surface
+    double seconds = 0.0;
+};
+
+struct RenderResult {
+    Image image;
+    RenderStats stats;
+};
+
+/// Renders the parameter set. A slice proven empty (provenEmptyReason in inspect.hpp) renders
+/// as background only. Throws ParamError for invalid parameters, Cancelled if
+/// `progress` returned false.
+DQJ_API RenderResult render(const Params& params, const ProgressCallback& progress = {});
+
+}  // namespace dqj

@@ -1,0 +1,321 @@
+// The C ABI: the only place that catches exceptions and turns them into status codes.
+// Handles are checked against a registry of live contexts, so a stale or garbage handle
+// gives DQJ_ERROR_INVALID_HANDLE instead of a crash.
+#include "dqjulia/dqjulia.h"
+
+#include <cmath>
+#include <cstring>
+#include <mutex>
+#include <new>
+#include <string>
+#include <unordered_set>
+
+#include "dqjulia/image.hpp"
+#include "dqjulia/inspect.hpp"
+#include "dqjulia/params.hpp"
+#include "dqjulia/render.hpp"
+
+struct dqj_context_t {
+    dqj::Params params;
+    std::string error;
+    std::string warning;
+};
+
+namespace {
+
+std::mutex registryMutex;
+std::unordered_set<const dqj_context_t*>& registry() {
+    static auto* live = new std::unordered_set<const dqj_context_t*>();  // never destroyed: safe at exit
+    return *live;
+}
+
+bool isLive(const dqj_context_t* context) {
+    if (!context) return false;
+    std::lock_guard lock(registryMutex);
+    return registry().count(context) != 0;
+}
+
+constexpr const char* kInvalidHandleMessage = "invalid dqjulia context (null, unknown or already destroyed)";
+
+/// Runs `body` for a live context, mapping every exception to a status and a message.
+template <typename Body>
+dqj_status guarded(dqj_context context, Body&& body) {
+    if (!isLive(context)) return DQJ_ERROR_INVALID_HANDLE;
+    context->error.clear();
+    context->warning.clear();
+    try {
+        return body(*context);
+    } catch (const dqj::ParamError& error) {
+        context->error = error.what();
+        return DQJ_ERROR_PARAMETERS;
+    } catch (const dqj::Cancelled&) {
+        context->error = "cancelled by the progress callback";
+        return DQJ_ERROR_CANCELLED;
+    } catch (const std::bad_alloc&) {
+        context->error = "out of memory";
+        return DQJ_ERROR_OUT_OF_MEMORY;
+    } catch (const std::system_error& error) {
+        context->error = error.what();
+        return DQJ_ERROR_IO;
+    } catch (const std::exception& error) {
+        context->error = error.what();
+        return DQJ_ERROR_INTERNAL;
+    } catch (...) {
+        context->error = "unknown internal error";
+        return DQJ_ERROR_INTERNAL;
+    }
+}
+
+dqj_status invalidArgument(dqj_context_t& context, const std::string& message) {
+    context.error = message;
+    return DQJ_ERROR_INVALID_ARGUMENT;
+}
+
+/// Applies `change` to a copy of the parameters and keeps it only if it validates.
+template <typename Change>
+dqj_status changeParams(dqj_context_t& context, Change&& change) {
+    dqj::Params candidate = context.params;
+    change(candidate);
+    dqj::validate(candidate);
+    context.params = std::move(candidate);
+    return DQJ_OK;
+}
+
+dqj_status copyText(dqj_context_t& context, const std::string& text, char* buffer, size_t capacity, size_t* outSize) {
+    if (outSize) *outSize = text.size() + 1;
+    if (!buffer) {
+        if (capacity != 0) return invalidArgument(context, "buffer is NULL but capacity is not 0");
+        return DQJ_OK;
+    }
+    if (capacity < text.size() + 1)
+        return invalidArgument(context, "buffer too small: " + std::to_string(text.size() + 1) + " bytes needed, " +
+                                            std::to_string(capacity) + " given");
+    std::memcpy(buffer, text.c_str(), text.size() + 1);
+    return DQJ_OK;
+}
+
+dqj::ProgressCallback wrapProgress(dqj_progress_fn progress, void* userData) {
+    if (!progress) return {};
+    return [progress, userData](double fraction) { return progress(fraction, userData) == 0; };
+}
+
+void fillSample(const dqj::Escape& escape, dqj_sample& sample) {
+    sample.n = escape.n;
+    sample.r = escape.r;
+    sample.ra = escape.ra;
+    sample.rb = escape.rb;
+    sample.de = escape.de;
+}
+
+/// After a render: if nothing was hit, say why on the context (a silent empty picture is a bug).
+void noteEmptyRender(dqj_context_t& context, const dqj::RenderResult& result) {
+    if (result.stats.hitPixels != 0) return;
+    const dqj::InspectReport report = dqj::inspect(context.params);
+    context.warning = "the render found no surface: " +
+                      (report.emptyReason.empty() ? std::string("no ray came within the hit threshold; try more iterations, "
+                                                                "a larger render.detail or another camera")
+                                                  : report.emptyReason);
+}
+
+}  // namespace
+
+extern "C" {
+
+unsigned dqj_version_number(void) { return DQJ_VERSION_NUMBER; }
+const char* dqj_version_string(void) { return DQJ_VERSION_STRING_FROM_BUILD; }
+
+const char* dqj_status_string(dqj_status status) {
+    switch (status) {
+        case DQJ_OK: return "ok";
+        case DQJ_ERROR_INVALID_HANDLE: return "invalid handle";
+        case DQJ_ERROR_INVALID_ARGUMENT: return "invalid argument";
+        case DQJ_ERROR_PARAMETERS: return "invalid parameters";
+        case DQJ_ERROR_IO: return "input/output error";
+        case DQJ_ERROR_CANCELLED: return "cancelled";
+        case DQJ_ERROR_OUT_OF_MEMORY: return "out of memory";
+        case DQJ_ERROR_INTERNAL: return "internal error";
+    }
+    return "unknown status";
+}
+
+dqj_status dqj_context_create(dqj_context* outContext) {
+    if (!outContext) return DQJ_ERROR_INVALID_ARGUMENT;
+    *outContext = nullptr;
+    try {
+        auto* context = new dqj_context_t();
+        std::lock_guard lock(registryMutex);
+        registry().insert(context);
+        *outContext = context;
+        return DQJ_OK;
+    } catch (const std::bad_alloc&) {
+        return DQJ_ERROR_OUT_OF_MEMORY;
+    } catch (...) {
+        return DQJ_ERROR_INTERNAL;
+    }
+}
+
+void dqj_context_destroy(dqj_context context) {
+    if (!context) return;
+    {
+        std::lock_guard lock(registryMutex);
+        if (registry().erase(context) == 0) return;  // unknown or already destroyed: ignore
+    }
+    delete context;
+}
+
+const char* dqj_context_error(dqj_context context) {
+    return isLive(context) ? context->error.c_str() : kInvalidHandleMessage;
+}
+
+const char* dqj_context_warning(dqj_context context) { return isLive(context) ? context->warning.c_str() : ""; }
+
+dqj_status dqj_context_load_params_file(dqj_context context, const char* path) {
+    return guarded(context, [&](dqj_context_t& self) {
+        if (!path) return invalidArgument(self, "path is NULL");
+        self.params = dqj::loadParams(path);
+        return DQJ_OK;
+    });
+}
+
+dqj_status dqj_context_set_params_json(dqj_context context, const char* json) {
+    return guarded(context, [&](dqj_context_t& self) {
+        if (!json) return invalidArgument(self, "json is NULL");
+        self.params = dqj::parseParams(json, "parameters");
+        return DQJ_OK;
+    });
+}
+
+dqj_status dqj_context_get_params_json(dqj_context context, char* buffer, size_t capacity, size_t* outSize) {
+    return guarded(context, [&](dqj_context_t& self) { return copyText(self, dqj::toJson(self.params), buffer, capacity, outSize); });
+}
+
+dqj_status dqj_context_set_constant(dqj_context context, const double c[8]) {
+    return guarded(context, [&](dqj_context_t& self) {
+        if (!c) return invalidArgument(self, "c is NULL");
+        dqj::Vec8 values;
+        for (int index = 0; index < 8; ++index) {
+            if (!std::isfinite(c[index]))
+                return invalidArgument(self, "c[" + std::to_string(index) + "] is not a finite number");
+            values[index] = c[index];
+        }
+        return changeParams(self, [&](dqj::Params& params) { params.fractal.c = dqj::toDualQuat(values); });
+    });
+}
+
+dqj_status dqj_context_set_variant(dqj_context context, dqj_variant variant) {
+    return guarded(context, [&](dqj_context_t& self) {
+        dqj::Variant value;
+        switch (variant) {
+            case DQJ_VARIANT_PAPER: value = dqj::Variant::Paper; break;
+            case DQJ_VARIANT_PAPER_COUPLED: value = dqj::Variant::PaperCoupled; break;
+            case DQJ_VARIANT_DUAL: value = dqj::Variant::Dual; break;
+            default: return invalidArgument(self, "variant must be DQJ_VARIANT_PAPER, _PAPER_COUPLED or _DUAL");
+        }
+        return changeParams(self, [&](dqj::Params& params) { params.fractal.variant = value; });
+    });
+}
+
+dqj_status dqj_context_set_iterations(dqj_context context, int iterations) {
+    return guarded(context, [&](dqj_context_t& self) {
+        return changeParams(self, [&](dqj::Params& params) { params.fractal.iterations = iterations; });
+    });
+}
+
+dqj_status dqj_context_set_bailout(dqj_context context, double bailout) {
+    return guarded(context, [&](dqj_context_t& self) {
+        return changeParams(self, [&](dqj::Params& params) { params.fractal.bailout = bailout; });
+    });
+}
+
+dqj_status dqj_context_set_slice_axes(dqj_context context, const char* axes) {
+    return guarded(context, [&](dqj_context_t& self) {
+        if (!axes) return invalidArgument(self, "axes is NULL");
+        dqj::Slice slice;
+        try {
+            slice = dqj::sliceFromAxisNames(axes);
+        } catch (const std::invalid_argument& error) {
+            return invalidArgument(self, std::string("slice axes: ") + error.what());
+        }
+        return changeParams(self, [&](dqj::Params& params) {
+            slice.origin = params.slice.base.origin;
+            params.slice.base = slice;
+            params.slice.rotations.clear();
+        });
+    });
+}
+
+dqj_status dqj_evaluate_points(dqj_context context, const double* points, size_t count, dqj_sample* out) {
+    return guarded(context, [&](dqj_context_t& self) {
+        if (count == 0) return DQJ_OK;
+        if (!points || !out) return invalidArgument(self, "points or out is NULL");
+        for (size_t index = 0; index < count; ++index) {
+            dqj::Vec8 point;
+            std::copy(points + 8 * index, points + 8 * index + 8, point.begin());
+            fillSample(dqj::evaluate(self.params.fractal, dqj::toDualQuat(point)), out[index]);
+        }
+        return DQJ_OK;
+    });
+}
+
+dqj_status dqj_evaluate_slice_points(dqj_context context, const double* points, size_t count, dqj_sample* out) {
+    return guarded(context, [&](dqj_context_t& self) {
+        if (count == 0) return DQJ_OK;
+        if (!points || !out) return invalidArgument(self, "points or out is NULL");
+        const dqj::Slice slice = self.params.slice.effective();
+        for (size_t index = 0; index < count; ++index) {
+            const glm::dvec3 p(points[3 * index], points[3 * index + 1], points[3 * index + 2]);
+            fillSample(dqj::evaluate(self.params.fractal, slice.map(p)), out[index]);
+        }
+        return DQJ_OK;
+    });
+}
+
+dqj_status dqj_render_rgba8(dqj_context context, uint8_t* pixels, uint32_t width, uint32_t height, size_t stride,
+                            dqj_progress_fn progress, void* userData) {
+    return guarded(context, [&](dqj_context_t& self) {
+        if (!pixels) return invalidArgument(self, "pixels is NULL");
+        if (width == 0 || height == 0 || width > 16384 || height > 16384)
+            return invalidArgument(self, "width and height must be from 1 to 16384");
+        if (stride < size_t(width) * 4) return invalidArgument(self, "stride is smaller than 4 * width");
+        dqj::Params params = self.params;
+        params.render.width = int(width);
+        params.render.height = int(height);
+        const dqj::RenderResult result = dqj::render(params, wrapProgress(progress, userData));
+        for (uint32_t y = 0; y < height; ++y) {
+            uint8_t* row = pixels + y * stride;
+            for (uint32_t x = 0; x < width; ++x) {
+                const float* rgba = &result.image.rgba[(size_t(y) * width + x) * 4];
+                for (int channel = 0; channel < 3; ++channel) row[4 * x + channel] = dqj::linearToSrgb8(rgba[channel]);
+                row[4 * x + 3] = uint8_t(std::lround(std::clamp(rgba[3], 0.0f, 1.0f) * 255.0f));
+            }
+        }
+        noteEmptyRender(self, result);
+        return DQJ_OK;
+    });
+}
+
+dqj_status dqj_render_to_file(dqj_context context, const char* path, dqj_progress_fn progress, void* userData) {
+    return guarded(context, [&](dqj_context_t& self) {
+        if (!path) return invalidArgument(self, "path is NULL");
+        dqj::Params params = self.params;
+        params.output.path = path;
+        dqj::validate(params);
+        const dqj::RenderResult result = dqj::render(params, wrapProgress(progress, userData));
+        try {
+            dqj::writeImage(result.image, path, dqj::formatFor(params.output));
+        } catch (const std::exception& error) {
+            self.error = error.what();
+            return DQJ_ERROR_IO;
+        }
+        noteEmptyRender(self, result);
+        return DQJ_OK;
+    });
+}
+
+dqj_status dqj_inspect_json(dqj_context context, char* buffer, size_t capacity, size_t* outSize) {
+    return guarded(context, [&](dqj_context_t& self) {
+        return copyText(self, dqj::reportJson(dqj::inspect(self.params)), buffer, capacity, outSize);
+    });
+}
+
+}  // extern "C"

@@ -1,0 +1,139 @@
+// The escape iteration of the three variants (math.md). Written once, in double precision;
+// the renderer, the C ABI and the CLI all call evaluate().
+#include "dqjulia/estimate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace dqj {
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+
+/// 0.5 |x| ln|x| / d for an escaped part; +inf when the derivative is zero
+/// (the orbit started on the critical point), which the marcher treats as "take the largest step".
+double partEstimate(double norm, double derivative) {
+    if (derivative == 0.0) return kInfinity;
+    return 0.5 * norm * std::log(norm) / derivative;
+}
+
+template <Variant V>
+Escape iterate(const Fractal& fractal, const DualQuat& start) {
+    const Quat ca = fractal.c.a;
+    const Quat cb = fractal.c.b;
+    const double bailout = fractal.bailout;
+    Quat a = start.a;
+    Quat b = start.b;
+    double ra = norm(a);
+    double rb = norm(b);
+    double da = 1.0;  // paper, dual: |da|; paper-coupled: the 8-D dr
+    double db = 1.0;
+    double trap = ra;
+    Escape result;
+    for (int k = 1; k <= fractal.iterations; ++k) {
+        if constexpr (V == Variant::Paper) {
+            da *= 2.0 * ra;
+            db *= 2.0 * rb;
+            a = square(a) + ca;
+            b = square(b) + cb;
+        } else if constexpr (V == Variant::PaperCoupled) {
+            da *= 2.0 * std::sqrt(ra * ra + rb * rb);
+            a = square(a) + ca;
+            b = square(b) + cb;
+        } else {
+            da *= 2.0 * ra;
+            const Quat previous = a;  // b must use the old a
+            a = square(a) + ca;
+            b = symmetricProduct(previous, b) + cb;
+        }
+        ra = norm(a);
+        rb = norm(b);
+        trap = std::min(trap, ra);
+        bool escaped;
+        if constexpr (V == Variant::Paper) {
+            escaped = ra > bailout || rb > bailout;
+        } else if constexpr (V == Variant::PaperCoupled) {
+            escaped = std::sqrt(ra * ra + rb * rb) > bailout;
+        } else {
+            escaped = ra > bailout;
+        }
+        if (escaped) {
+            result.n = k;
+            break;
+        }
+    }
+    result.ra = ra;
+    result.rb = rb;
+    result.trap = trap;
+    result.exit = {a, b};
+    if constexpr (V == Variant::Paper) {
+        result.r = std::max(ra, rb);
+        if (result.n != 0) {
+            // max, not min: min is 0 wherever one part never escapes and the marcher stalls.
+            const double deA = ra > bailout ? partEstimate(ra, da) : 0.0;
+            const double deB = rb > bailout ? partEstimate(rb, db) : 0.0;
+            result.de = std::max(deA, deB);
+        }
+    } else if constexpr (V == Variant::PaperCoupled) {
+        result.r = std::sqrt(ra * ra + rb * rb);
+        if (result.n != 0) result.de = partEstimate(result.r, da);
+    } else {
+        result.r = ra;
+        if (result.n != 0) result.de = partEstimate(ra, da);
+    }
+    return result;
+}
+
+}  // namespace
+
+Escape evaluate(const Fractal& fractal, const DualQuat& start) {
+    switch (fractal.variant) {
+        case Variant::Paper: return iterate<Variant::Paper>(fractal, start);
+        case Variant::PaperCoupled: return iterate<Variant::PaperCoupled>(fractal, start);
+        case Variant::Dual: return iterate<Variant::Dual>(fractal, start);
+    }
+    return {};
+}
+
+double distanceEstimate(const Fractal& fractal, const DualQuat& start) { return evaluate(fractal, start).de; }
+
+double containmentRadius(const Quat& c) { return 0.5 * (1.0 + std::sqrt(1.0 + 4.0 * norm(c))); }
+
+double minimumBailout(const Fractal& fractal) {
+    const double realRadius = containmentRadius(fractal.c.a);
+    if (fractal.variant == Variant::Dual) return realRadius;  // only |a| is tested
+    return std::max(realRadius, containmentRadius(fractal.c.b));
+}
+
+glm::dvec3 realPartGradient(const Fractal& fractal, const Quat& start, const Quat directions[3]) {
+    Quat a = start;
+    Quat b[3] = {directions[0], directions[1], directions[2]};
+    for (int k = 1; k <= fractal.iterations; ++k) {
+        const Quat previous = a;
+        a = square(a) + fractal.c.a;
+        for (Quat& tangent : b) tangent = symmetricProduct(previous, tangent);  // c_b = 0
+        if (norm(a) > fractal.bailout) break;
+    }
+    const double normSquared = dot4(a, a);
+    if (normSquared == 0.0) return glm::dvec3(0.0);
+    return glm::dvec3(dot4(a, b[0]), dot4(a, b[1]), dot4(a, b[2])) / normSquared;
+}
+
+std::string_view variantName(Variant variant) {
+    switch (variant) {
+        case Variant::Paper: return "paper";
+        case Variant::PaperCoupled: return "paper-coupled";
+        case Variant::Dual: return "dual";
+    }
+    return "unknown";
+}
+
+std::optional<Variant> parseVariant(std::string_view name) {
+    if (name == "paper") return Variant::Paper;
+    if (name == "paper-coupled") return Variant::PaperCoupled;
+    if (name == "dual") return Variant::Dual;
+    return std::nullopt;
+}
+
+}  // namespace dqj

@@ -1,0 +1,301 @@
+// Image files: 8- and 16-bit sRGB PNG through libpng, linear EXR with depth and normals
+// through OpenEXR. Every write goes through AtomicFile, so a failed write leaves nothing behind.
+#include "dqjulia/image.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <csetjmp>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <limits>
+#include <stdexcept>
+#include <vector>
+
+#include <png.h>
+
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfOutputFile.h>
+#include <half.h>
+
+#include "atomic_file.hpp"
+
+namespace dqj {
+namespace {
+
+// ---------------------------------------------------------------- colour transfer
+
+/// Linear -> sRGB-encoded value in [0, 1]; NaN and negatives become 0.
+double encodeSrgb(double linear) {
+    if (!(linear > 0.0)) return 0.0;
+    if (linear >= 1.0) return 1.0;
+    return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
+}
+
+double decodeSrgb(double encoded) {
+    return encoded <= 0.04045 ? encoded / 12.92 : std::pow((encoded + 0.055) / 1.055, 2.4);
+}
+
+// ---------------------------------------------------------------- libpng, C style
+//
+// libpng reports errors by longjmp. The functions below that call setjmp hold only plain C
+// values, so the jump skips no C++ destructor; the C++ code around them owns the buffers.
+
+struct PngError {
+    char message[256] = "unknown libpng error";
+};
+
+void onPngError(png_structp png, png_const_charp message) {
+    auto* error = static_cast<PngError*>(png_get_error_ptr(png));
+    std::snprintf(error->message, sizeof error->message, "%s", message);
+    png_longjmp(png, 1);
+}
+
+void onPngWarning(png_structp, png_const_charp) {}  // warnings (e.g. odd chunks) are not failures
+
+/// Writes RGB rows (8 or 16 bits per sample, 16-bit big-endian) with an sRGB chunk.
+bool writePngRows(std::FILE* file, png_uint_32 width, png_uint_32 height, int bitDepth, png_bytepp rows,
+                  PngError* error) {
+    png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, error, onPngError, onPngWarning);
+    if (!png) return false;
+    png_infop info = png_create_info_struct(png);
+    if (!info) {
+        png_destroy_write_struct(&png, nullptr);
+        return false;
+    }
+    if (setjmp(png_jmpbuf(png))) {
+        png_destroy_write_struct(&png, &info);
+        return false;
+    }
+    png_init_io(png, file);
+    png_set_IHDR(png, info, width, height, bitDepth, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
+                 PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+    png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
+    png_write_info(png, info);
+    png_write_image(png, rows);
+    png_write_end(png, info);
+    png_destroy_write_struct(&png, &info);
+    return true;
+}
+
+/// A read in progress; PngReadGuard destroys it on every path.
+struct PngRead {
+    std::FILE* file = nullptr;
+    png_structp png = nullptr;
+    png_infop info = nullptr;
+    PngError error;
+    png_uint_32 width = 0;
+    png_uint_32 height = 0;
+    int bitDepth = 8;      ///< after the transforms: 8 or 16, RGBA
+    bool srgb = true;      ///< false: plain power law with `gamma`
+    double gamma = 1.0;    ///< file gamma from gAMA: encoded = linear^gamma
+};
+
+/// Reads the header and sets the transforms that turn any PNG into 8- or 16-bit RGBA.
+bool readPngHeader(PngRead* read) {
+    read->png = png_create_read_struct(PNG_LIBPNG_VER_STRING, &read->error, onPngError, onPngWarning);
+    if (!read->png) return false;
+    read->info = png_create_info_struct(read->png);
+    if (!read->info) return false;
+    if (setjmp(png_jmpbuf(read->png))) return false;
+    png_init_io(read->png, read->file);
+    png_read_info(read->png, read->info);
+    const int colorType = png_get_color_type(read->png, read->info);
+    const int bitDepth = png_get_bit_depth(read->png, read->info);
+    if (colorType == PNG_COLOR_TYPE_PALETTE) png_set_palette_to_rgb(read->png);
+    if (colorType == PNG_COLOR_TYPE_GRAY && bitDepth < 8) png_set_expand_gray_1_2_4_to_8(read->png);
+    if (png_get_valid(read->png, read->info, PNG_INFO_tRNS)) png_set_tRNS_to_alpha(read->png);
+    if (colorType == PNG_COLOR_TYPE_GRAY || colorType == PNG_COLOR_TYPE_GRAY_ALPHA) png_set_gray_to_rgb(read->png);
+    if (!(colorType & PNG_COLOR_MASK_ALPHA) && !png_get_valid(read->png, read->info, PNG_INFO_tRNS))
+        png_set_add_alpha(read->png, 0xffff, PNG_FILLER_AFTER);
+    png_set_interlace_handling(read->png);
+    // Files without colour information are taken to be sRGB, as browsers do.
+    int intent = 0;
+    double fileGamma = 0.0;
+    if (!png_get_sRGB(read->png, read->info, &intent) && png_get_gAMA(read->png, read->info, &fileGamma) &&
+        fileGamma > 0.0) {
+        read->srgb = false;
+        read->gamma = fileGamma;
+    }
+    png_read_update_info(read->png, read->info);
+    read->width = png_get_image_width(read->png, read->info);
+    read->height = png_get_image_height(read->png, read->info);
+    read->bitDepth = png_get_bit_depth(read->png, read->info);
+    return true;
+}
+
+bool readPngRows(PngRead* read, png_bytepp rows) {
+    if (setjmp(png_jmpbuf(read->png))) return false;
+    png_read_image(read->png, rows);
+    png_read_end(read->png, nullptr);
+    return true;
+}
+
+struct PngReadGuard {
+    PngRead& read;
+    ~PngReadGuard() {
+        if (read.png) png_destroy_read_struct(&read.png, read.info ? &read.info : nullptr, nullptr);
+        if (read.file) std::fclose(read.file);
+    }
+};
+
+// ---------------------------------------------------------------- writers
+
+void checkImage(const Image& image, const std::string& path) {
+    const std::size_t pixels = static_cast<std::size_t>(std::max(image.width, 0)) * std::max(image.height, 0);
+    if (image.width <= 0 || image.height <= 0 || image.rgba.size() != 4 * pixels)
+        throw std::runtime_error(AtomicFile::failureMessage(path, "the image is empty or its pixel buffer has the wrong size"));
+    if (!image.depth.empty() && image.depth.size() != pixels)
+        throw std::runtime_error(AtomicFile::failureMessage(path, "the depth buffer has the wrong size"));
+    if (!image.normal.empty() && image.normal.size() != 3 * pixels)
+        throw std::runtime_error(AtomicFile::failureMessage(path, "the normal buffer has the wrong size"));
+}
+
+void writePng(const Image& image, const std::string& path, int bitDepth) {
+    const std::size_t width = image.width;
+    const std::size_t height = image.height;
+    const std::size_t bytesPerSample = bitDepth == 16 ? 2 : 1;
+    const double scale = bitDepth == 16 ? 65535.0 : 255.0;
+    std::vector<png_byte> data(width * height * 3 * bytesPerSample);
+    for (std::size_t pixel = 0; pixel < width * height; ++pixel) {
+        for (std::size_t channel = 0; channel < 3; ++channel) {
+            const auto value = static_cast<unsigned>(std::lround(encodeSrgb(image.rgba[4 * pixel + channel]) * scale));
+            png_byte* out = &data[(3 * pixel + channel) * bytesPerSample];
+            if (bitDepth == 16) {
+                out[0] = static_cast<png_byte>(value >> 8);  // PNG stores 16-bit samples big-endian
+                out[1] = static_cast<png_byte>(value & 0xff);
+            } else {
+                out[0] = static_cast<png_byte>(value);
+            }
+        }
+    }
+    std::vector<png_bytep> rows(height);
+    for (std::size_t row = 0; row < height; ++row) rows[row] = &data[row * width * 3 * bytesPerSample];
+
+    AtomicFile target(path);
+    std::FILE* file = std::fopen(target.tempPath().c_str(), "wb");
+    if (!file) throw std::runtime_error(AtomicFile::failureMessage(path, std::strerror(errno)));
+    PngError error;
+    const bool written = writePngRows(file, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height),
+                                      bitDepth, rows.data(), &error);
+    // fclose flushes: a full disk shows up here, not in libpng.
+    const bool flushed = std::fflush(file) == 0 && !std::ferror(file);
+    const int closeError = std::fclose(file) == 0 ? 0 : errno;
+    if (!written) throw std::runtime_error(AtomicFile::failureMessage(path, error.message));
+    if (!flushed || closeError) throw std::runtime_error(AtomicFile::failureMessage(path, std::strerror(closeError ? closeError : EIO)));
+    target.commit();
+}
+
+void writeExr(const Image& image, const std::string& path) {
+    const std::size_t width = image.width;
+    const std::size_t height = image.height;
+    const std::size_t pixels = width * height;
+    // Colours as HALF (ample for display-referred linear light); depth and normals as FLOAT,
+    // since compositing (depth of field, relighting) needs their precision.
+    std::vector<half> rgba(image.rgba.size());
+    for (std::size_t index = 0; index < rgba.size(); ++index) rgba[index] = half(image.rgba[index]);
+    // Misses have depth +inf in memory; in the file they get 1e10, as Blender writes for its
+    // background, because infinities break many compositing nodes.
+    std::vector<float> depth(image.depth);
+    for (float& value : depth)
+        if (!std::isfinite(value)) value = 1e10f;
+
+    Imf::Header header(image.width, image.height);
+    header.compression() = Imf::ZIP_COMPRESSION;
+    Imf::FrameBuffer frame;
+    const char* colorNames[4] = {"R", "G", "B", "A"};
+    for (int channel = 0; channel < 4; ++channel) {
+        header.channels().insert(colorNames[channel], Imf::Channel(Imf::HALF));
+        frame.insert(colorNames[channel], Imf::Slice(Imf::HALF, reinterpret_cast<char*>(rgba.data() + channel),
+                                                     4 * sizeof(half), 4 * sizeof(half) * width));
+    }
+    if (!depth.empty()) {
+        header.channels().insert("Z", Imf::Channel(Imf::FLOAT));
+        frame.insert("Z", Imf::Slice(Imf::FLOAT, reinterpret_cast<char*>(depth.data()), sizeof(float),
+                                     sizeof(float) * width));
+    }
+    if (image.normal.size() == 3 * pixels) {
+        const char* normalNames[3] = {"N.X", "N.Y", "N.Z"};
+        // OpenEXR only reads from the buffer; the const_cast is its API's, not a write.
+        char* base = reinterpret_cast<char*>(const_cast<float*>(image.normal.data()));
+        for (int channel = 0; channel < 3; ++channel) {
+            header.channels().insert(normalNames[channel], Imf::Channel(Imf::FLOAT));
+            frame.insert(normalNames[channel], Imf::Slice(Imf::FLOAT, base + channel * sizeof(float),
+                                                          3 * sizeof(float), 3 * sizeof(float) * width));
+        }
+    }
+
+    AtomicFile target(path);
+    try {
+        Imf::OutputFile file(target.tempPath().c_str(), header);
+        file.setFrameBuffer(frame);
+        file.writePixels(image.height);
+    } catch (const std::exception& error) {
+        throw std::runtime_error(AtomicFile::failureMessage(path, error.what()));
+    }
+    target.commit();
+}
+
+}  // namespace
+
+std::uint8_t linearToSrgb8(float linear) { return static_cast<std::uint8_t>(std::lround(encodeSrgb(linear) * 255.0)); }
+
+void writeImage(const Image& image, const std::string& path, ImageFormat format) {
+    checkImage(image, path);
+    switch (format) {
+        case ImageFormat::Png8: writePng(image, path, 8); return;
+        case ImageFormat::Png16: writePng(image, path, 16); return;
+        case ImageFormat::Exr: writeExr(image, path); return;
+    }
+    throw std::runtime_error(AtomicFile::failureMessage(path, "unknown image format"));
+}
+
+Image readPng(const std::string& path) {
+    auto fail = [&](const std::string& reason) { return std::runtime_error("cannot read '" + path + "': " + reason); };
+    PngRead read;
+    PngReadGuard guard{read};
+    read.file = std::fopen(path.c_str(), "rb");
+    if (!read.file) throw fail(std::strerror(errno));
+    png_byte signature[8] = {};
+    if (std::fread(signature, 1, 8, read.file) != 8 || png_sig_cmp(signature, 0, 8) != 0) throw fail("not a PNG file");
+    std::rewind(read.file);
+    if (!readPngHeader(&read)) throw fail(read.error.message);
+
+    const std::size_t width = read.width;
+    const std::size_t height = read.height;
+    const std::size_t bytesPerSample = read.bitDepth == 16 ? 2 : 1;
+    const std::size_t rowBytes = width * 4 * bytesPerSample;
+    if (png_get_rowbytes(read.png, read.info) != rowBytes) throw fail("unsupported PNG layout");
+    std::vector<png_byte> data(rowBytes * height);
+    std::vector<png_bytep> rows(height);
+    for (std::size_t row = 0; row < height; ++row) rows[row] = &data[row * rowBytes];
+    if (!readPngRows(&read, rows.data())) throw fail(read.error.message);
+
+    const double maximum = read.bitDepth == 16 ? 65535.0 : 255.0;
+    auto toLinear = [&](double encoded) { return read.srgb ? decodeSrgb(encoded) : std::pow(encoded, 1.0 / read.gamma); };
+    // 8-bit files: decode the 256 possible values once.
+    std::array<float, 256> table{};
+    for (int value = 0; value < 256; ++value) table[value] = static_cast<float>(toLinear(value / 255.0));
+
+    Image image;
+    image.width = static_cast<int>(width);
+    image.height = static_cast<int>(height);
+    image.rgba.resize(width * height * 4);
+    for (std::size_t sample = 0; sample < width * height * 4; ++sample) {
+        const bool alpha = sample % 4 == 3;  // alpha is linear coverage, never gamma-encoded
+        if (bytesPerSample == 2) {
+            const unsigned value = (unsigned{data[2 * sample]} << 8) | data[2 * sample + 1];
+            image.rgba[sample] = static_cast<float>(alpha ? value / maximum : toLinear(value / maximum));
+        } else {
+            const unsigned value = data[sample];
+            image.rgba[sample] = alpha ? static_cast<float>(value / maximum) : table[value];
+        }
+    }
+    return image;
+}
+
+}  // namespace dqj

@@ -1,0 +1,112 @@
+// parallel_progress.hpp - run independent work items over TBB threads while the calling thread
+// reports progress and handles cancellation (progress.hpp).
+//
+// Internal to libdqjulia. The renderer runs image tiles through it, the baker slabs of a grid.
+// The calling thread only waits and calls the user's callback (at the start, a few times a
+// second and once with 1.0 at the end), so a host such as Blender sees the callback on the thread that asked
+// for the work. Cost: one extra thread per call; the items themselves run on TBB's pool.
+#pragma once
+
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstddef>
+#include <exception>
+#include <functional>
+#include <mutex>
+#include <thread>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "dqjulia/progress.hpp"
+
+namespace dqj {
+
+/// One work item. `stop` becomes true when the user cancelled or another item failed;
+/// long items should poll it and return early (short ones may ignore it: items not yet
+/// started are skipped anyway).
+using WorkItem = std::function<void(std::size_t index, const std::atomic<bool>& stop)>;
+
+/// Runs work(index) for every index in [0, count) in parallel. With a callback, it is called
+/// with 0.0 before any work starts, with the fraction of items done about every 100 ms, and
+/// with 1.0 at the end. If it returns
+/// false, the remaining items are skipped and Cancelled is thrown once all threads are idle.
+/// The first exception thrown by an item (or by the callback) is rethrown on the calling thread.
+inline void parallelForWithProgress(std::size_t count, const ProgressCallback& progress, const WorkItem& work) {
+    std::atomic<bool> stop{false};
+    std::atomic<std::size_t> done{0};
+    std::mutex errorMutex;
+    std::exception_ptr error;
+
+    // Items never throw into TBB: the first failure is kept and the rest are skipped.
+    auto runItems = [&] {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1), [&](const tbb::blocked_range<std::size_t>& range) {
+            for (std::size_t index = range.begin(); index != range.end(); ++index) {
+                if (stop.load(std::memory_order_relaxed)) return;
+                try {
+                    work(index, stop);
+                } catch (...) {
+                    std::lock_guard<std::mutex> lock(errorMutex);
+                    if (!error) error = std::current_exception();
+                    stop = true;
+                }
+                done.fetch_add(1, std::memory_order_relaxed);
+            }
+        });
+    };
+
+    if (!progress) {
+        runItems();
+        if (error) std::rethrow_exception(error);
+        return;
+    }
+
+    if (!progress(0.0)) throw Cancelled();  // lets a caller cancel even work shorter than 100 ms
+
+    std::mutex mutex;
+    std::condition_variable finishedSignal;
+    bool finished = false;
+    std::thread worker([&] {
+        runItems();
+        {
+            std::lock_guard<std::mutex> lock(mutex);
+            finished = true;
+        }
+        finishedSignal.notify_one();
+    });
+    // The worker must be joined on every path, or std::thread's destructor terminates.
+    struct Joiner {
+        std::thread& thread;
+        std::atomic<bool>& stop;
+        ~Joiner() {
+            if (thread.joinable()) {
+                stop = true;
+                thread.join();
+            }
+        }
+    } joiner{worker, stop};
+
+    bool cancelled = false;
+    {
+        std::unique_lock<std::mutex> lock(mutex);
+        while (!finished) {
+            if (finishedSignal.wait_for(lock, std::chrono::milliseconds(100), [&] { return finished; })) break;
+            if (cancelled) continue;  // only waiting for running items to return
+            lock.unlock();
+            const double fraction = count ? static_cast<double>(done.load()) / static_cast<double>(count) : 1.0;
+            const bool keepGoing = progress(fraction);  // if it throws, Joiner stops and joins
+            lock.lock();
+            if (!keepGoing) {
+                cancelled = true;
+                stop = true;
+            }
+        }
+    }
+    worker.join();
+    if (error) std::rethrow_exception(error);
+    if (cancelled) throw Cancelled();
+    progress(1.0);  // the work is complete: a late "false" has nothing left to cancel
+}
+
+}  // namespace dqj

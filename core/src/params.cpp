@@ -1,0 +1,587 @@
+// The parameter file: JSON in, validated Params out, and back. Every message names the file,
+// the dotted key, what was wrong and what is allowed.
+#include "dqjulia/params.hpp"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include <glm/geometric.hpp>
+#include <nlohmann/json.hpp>
+
+namespace dqj {
+
+ParamError::ParamError(std::string key, const std::string& message)
+    : std::runtime_error(message), key_(std::move(key)) {}
+
+namespace {
+
+using Json = nlohmann::json;
+using OrderedJson = nlohmann::ordered_json;
+
+constexpr int kFormatVersion = 1;
+
+std::size_t editDistance(const std::string& a, const std::string& b) {
+    std::vector<std::size_t> previous(b.size() + 1), current(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) previous[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+        current[0] = i;
+        for (std::size_t j = 1; j <= b.size(); ++j)
+            current[j] = std::min({previous[j] + 1, current[j - 1] + 1, previous[j - 1] + (a[i - 1] != b[j - 1])});
+        std::swap(previous, current);
+    }
+    return previous[b.size()];
+}
+
+std::string describe(const Json& value) {
+    std::string text = value.dump();
+    if (text.size() > 40) text = text.substr(0, 37) + "...";
+    return std::string(value.type_name()) + " " + text;
+}
+
+std::string formatNumber(double value) {
+    std::ostringstream out;
+    out << value;
+    return out.str();
+}
+
+/// Walks one JSON object: reads known keys with type and range checks, then rejects any key
+/// it was not asked about, suggesting the nearest known one.
+class ObjectReader {
+public:
+    ObjectReader(const Json& node, std::string path, const std::string& source)
+        : node_(node), path_(std::move(path)), source_(source) {
+        if (!node_.is_object()) fail(path_, "must be an object {...}, got " + describe(node_));
+    }
+
+    [[noreturn]] void fail(const std::string& key, const std::string& message) const {
+        throw ParamError(key, source_ + ": " + (key.empty() ? "" : key + ": ") + message);
+    }
+    std::string keyPath(const std::string& key) const { return path_.empty() ? key : path_ + "." + key; }
+
+    /// The value at `key`, or nullptr if absent; records the key as known.
+    const Json* find(const std::string& key) {
+        known_.push_back(key);
+        const auto it = node_.find(key);
+        return it == node_.end() ? nullptr : &*it;
+    }
+
+    double number(const Json& value, const std::string& key, double low, double high, bool lowOpen = false) const {
+        if (!value.is_number()) fail(key, "must be a number, got " + describe(value));
+        const double x = value.get<double>();
+        if (!std::isfinite(x)) fail(key, "must be a finite number");
+        if (x < low || x > high || (lowOpen && x == low))
+            fail(key, "must be " + std::string(lowOpen ? "greater than " : "at least ") + formatNumber(low) +
+                          " and at most " + formatNumber(high) + ", got " + formatNumber(x));
+        return x;
+    }
+
+    void readNumber(const std::string& key, double& out, double low, double high, bool lowOpen = false) {
+        if (const Json* value = find(key)) out = number(*value, keyPath(key), low, high, lowOpen);
+    }
+
+    void readInteger(const std::string& key, int& out, int low, int high) {
+        const Json* value = find(key);
+        if (!value) return;
+        if (!value->is_number_integer() && !(value->is_number_float() && std::nearbyint(value->get<double>()) == value->get<double>()))
+            fail(keyPath(key), "must be a whole number, got " + describe(*value));
+        const double x = value->get<double>();
+        if (x < low || x > high)
+            fail(keyPath(key), "must be a whole number from " + std::to_string(low) + " to " + std::to_string(high) +
+                                   ", got " + formatNumber(x));
+        out = static_cast<int>(x);
+    }
+
+    void readBool(const std::string& key, bool& out) {
+        const Json* value = find(key);
+        if (!value) return;
+        if (!value->is_boolean()) fail(keyPath(key), "must be true or false, got " + describe(*value));
+        out = value->get<bool>();
+    }
+
+    void readString(const std::string& key, std::string& out) {
+        const Json* value = find(key);
+        if (!value) return;
+        if (!value->is_string()) fail(keyPath(key), "must be a string, got " + describe(*value));
+        out = value->get<std::string>();
+    }
+
+    /// A fixed-length array of finite numbers, each within [low, high].
+    template <std::size_t Size>
+    std::array<double, Size> array(const Json& value, const std::string& key, double low = -1e9, double high = 1e9) const {
+        if (!value.is_array() || value.size() != Size)
+            fail(key, "must be an array of " + std::to_string(Size) + " numbers, got " + describe(value));
+        std::array<double, Size> result{};
+        for (std::size_t index = 0; index < Size; ++index)
+            result[index] = number(value[index], key + "[" + std::to_string(index) + "]", low, high);
+        return result;
+    }
+
+    glm::dvec3 vec3(const Json& value, const std::string& key, double low = -1e9, double high = 1e9) const {
+        const auto a = array<3>(value, key, low, high);
+        return {a[0], a[1], a[2]};
+    }
+    void readVec3(const std::string& key, glm::dvec3& out, double low = -1e9, double high = 1e9) {
+        if (const Json* value = find(key)) out = vec3(*value, keyPath(key), low, high);
+    }
+    void readColor(const std::string& key, glm::dvec3& out) { readVec3(key, out, 0.0, 1000.0); }
+
+    /// Rejects keys nobody asked for ("unknown key 'iteratons'; did you mean 'iterations'?").
+    void finish() const {
+        for (const auto& item : node_.items()) {
+            if (std::find(known_.begin(), known_.end(), item.key()) != known_.end()) continue;
+            std::string nearest;
+            std::size_t best = std::string::npos;
+            for (const std::string& candidate : known_) {
+                const std::size_t distance = editDistance(item.key(), candidate);
+                if (distance < best) {
+                    best = distance;
+                    nearest = candidate;
+                }
+            }
+            std::string message = "unknown key \"" + item.key() + "\"";
+            if (best <= std::max<std::size_t>(2, item.key().size() / 3)) message += "; did you mean \"" + nearest + "\"?";
+            std::string allowed;
+            for (const std::string& candidate : known_) allowed += (allowed.empty() ? "" : ", ") + candidate;
+            fail(keyPath(item.key()), message + " (allowed here: " + allowed + ")");
+        }
+    }
+
+    const std::string& path() const { return path_; }
+    const std::string& source() const { return source_; }
+
+private:
+    const Json& node_;
+    std::string path_;
+    const std::string& source_;
+    std::vector<std::string> known_;
+};
+
+template <typename Enum, std::size_t Count>
+Enum parseChoice(ObjectReader& reader, const Json& value, const std::string& key,
+                 const std::array<std::pair<std::string_view, Enum>, Count>& choices) {
+    std::string allowed;
+    for (const auto& [name, choice] : choices) allowed += (allowed.empty() ? "" : ", ") + std::string(name);
+    if (!value.is_string()) reader.fail(key, "must be one of " + allowed + ", got " + describe(value));
+    for (const auto& [name, choice] : choices)
+        if (value.get<std::string>() == name) return choice;
+    reader.fail(key, "must be one of " + allowed + ", got \"" + value.get<std::string>() + "\"");
+}
+
+constexpr std::array<std::pair<std::string_view, Variant>, 3> kVariants{
+    {{"paper", Variant::Paper}, {"paper-coupled", Variant::PaperCoupled}, {"dual", Variant::Dual}}};
+constexpr std::array<std::pair<std::string_view, Coloring>, 3> kColorings{
+    {{"solid", Coloring::Solid}, {"iterations", Coloring::Iterations}, {"trap", Coloring::Trap}}};
+constexpr std::array<std::pair<std::string_view, NormalMethod>, 3> kNormalMethods{
+    {{"auto", NormalMethod::Auto}, {"central", NormalMethod::CentralDifferences}, {"analytic", NormalMethod::Analytic}}};
+constexpr std::array<std::pair<std::string_view, ImageFormat>, 3> kFormats{
+    {{"png8", ImageFormat::Png8}, {"png16", ImageFormat::Png16}, {"exr", ImageFormat::Exr}}};
+
+template <typename Enum, std::size_t Count>
+std::string_view nameOf(Enum value, const std::array<std::pair<std::string_view, Enum>, Count>& choices) {
+    for (const auto& [name, choice] : choices)
+        if (choice == value) return name;
+    return "unknown";
+}
+
+void readFractal(ObjectReader reader, Fractal& fractal) {
+    if (const Json* value = reader.find("c")) fractal.c = toDualQuat(reader.array<8>(*value, reader.keyPath("c"), -100.0, 100.0));
+    if (const Json* value = reader.find("variant"))
+        fractal.variant = parseChoice(reader, *value, reader.keyPath("variant"), kVariants);
+    reader.readInteger("iterations", fractal.iterations, 1, 100000);
+    reader.readNumber("bailout", fractal.bailout, 1.0, 1e150, true);
+    reader.finish();
+}
+
+Vec8 readVec8(const ObjectReader& reader, const Json& value, const std::string& key) {
+    const auto a = reader.array<8>(value, key);
+    Vec8 v;
+    std::copy(a.begin(), a.end(), v.begin());
+    return v;
+}
+
+void readSlice(ObjectReader reader, SliceSpec& slice) {
+    if (const Json* value = reader.find("axes")) {
+        const std::string key = reader.keyPath("axes");
+        if (value->is_string()) {
+            try {
+                const Vec8 origin = slice.base.origin;
+                slice.base = sliceFromAxisNames(value->get<std::string>());
+                slice.base.origin = origin;
+            } catch (const std::invalid_argument& error) {
+                reader.fail(key, error.what());
+            }
+        } else if (value->is_array() && value->size() == 3) {
+            for (std::size_t axis = 0; axis < 3; ++axis)
+                slice.base.axes[axis] = readVec8(reader, (*value)[axis], key + "[" + std::to_string(axis) + "]");
+        } else {
+            reader.fail(key, "must be axis names like \"a.s,a.i,a.j\" or an array of three 8-number vectors, got " +
+                                 describe(*value));
+        }
+    }
+    if (const Json* value = reader.find("origin")) slice.base.origin = readVec8(reader, *value, reader.keyPath("origin"));
+    if (const Json* value = reader.find("rotations")) {
+        const std::string key = reader.keyPath("rotations");
+        if (!value->is_array()) reader.fail(key, "must be an array of {\"plane\": \"a.j,b.s\", \"degrees\": 30}, got " + describe(*value));
+        slice.rotations.clear();
+        for (std::size_t index = 0; index < value->size(); ++index) {
+            ObjectReader item((*value)[index], key + "[" + std::to_string(index) + "]", reader.source());
+            PlaneRotation rotation;
+            std::string plane;
+            item.readString("plane", plane);
+            const std::size_t comma = plane.find(',');
+            const auto first = parseAxisName(plane.substr(0, comma));
+            const auto second = comma == std::string::npos ? std::nullopt : parseAxisName(plane.substr(comma + 1));
+            if (!first || !second || *first == *second)
+                item.fail(item.keyPath("plane"), "must name two different axes like \"a.j,b.s\" (axes: a.s a.i a.j a.k b.s b.i b.j b.k), got \"" + plane + "\"");
+            rotation.first = *first;
+            rotation.second = *second;
+            item.readNumber("degrees", rotation.degrees, -36000.0, 36000.0);
+            item.finish();
+            slice.rotations.push_back(rotation);
+        }
+    }
+    reader.finish();
+}
+
+void readBounds(ObjectReader reader, std::optional<Bounds>& bounds) {
+    Bounds result;
+    reader.readVec3("center", result.center);
+    reader.readNumber("radius", result.radius, 0.0, 1e6, true);
+    reader.finish();
+    bounds = result;
+}
+
+void readCamera(ObjectReader reader, Camera& camera) {
+    if (const Json* value = reader.find("position")) camera.position = reader.vec3(*value, reader.keyPath("position"));
+    if (const Json* value = reader.find("target")) camera.target = reader.vec3(*value, reader.keyPath("target"));
+    reader.readVec3("direction", camera.direction);
+    reader.readVec3("up", camera.up);
+    reader.readNumber("fov", camera.fovDegrees, 0.0, 170.0, true);
+    reader.finish();
+}
+
+void readLights(ObjectReader& parent, const Json& value, std::vector<Light>& lights) {
+    const std::string key = parent.keyPath("lights");
+    if (!value.is_array()) parent.fail(key, "must be an array of lights {\"direction\", \"color\", \"intensity\"}, got " + describe(value));
+    lights.clear();
+    for (std::size_t index = 0; index < value.size(); ++index) {
+        ObjectReader reader(value[index], key + "[" + std::to_string(index) + "]", parent.source());
+        Light light;
+        reader.readVec3("direction", light.direction);
+        reader.readColor("color", light.color);
+        reader.readNumber("intensity", light.intensity, 0.0, 1000.0);
+        reader.finish();
+        lights.push_back(light);
+    }
+}
+
+void readMaterial(ObjectReader reader, Material& material) {
+    reader.readColor("color", material.color);
+    if (const Json* value = reader.find("coloring"))
+        material.coloring = parseChoice(reader, *value, reader.keyPath("coloring"), kColorings);
+    if (const Json* value = reader.find("palette")) {
+        const std::string key = reader.keyPath("palette");
+        if (!value->is_array() || value->empty() || value->size() > 64)
+            reader.fail(key, "must be an array of 1 to 64 colours [r, g, b], got " + describe(*value));
+        material.palette.clear();
+        for (std::size_t index = 0; index < value->size(); ++index)
+            material.palette.push_back(reader.vec3((*value)[index], key + "[" + std::to_string(index) + "]", 0.0, 1000.0));
+    }
+    reader.readNumber("ambient", material.ambient, 0.0, 100.0);
+    reader.readNumber("diffuse", material.diffuse, 0.0, 100.0);
+    reader.readNumber("specular", material.specular, 0.0, 100.0);
+    reader.readNumber("shininess", material.shininess, 0.0, 10000.0);
+    reader.readNumber("occlusion", material.occlusion, 0.0, 1.0);
+    reader.readBool("shadows", material.shadows);
+    reader.readNumber("shadow_softness", material.shadowSoftness, 0.0, 1000.0, true);
+    reader.finish();
+}
+
+void readRender(ObjectReader reader, RenderSettings& render) {
+    reader.readInteger("width", render.width, 1, 16384);
+    reader.readInteger("height", render.height, 1, 16384);
+    reader.readInteger("samples", render.samples, 1, 16);
+    reader.readNumber("step_factor", render.stepFactor, 0.0, 1.0, true);
+    reader.readNumber("max_step", render.maxStep, 0.0, 1e6, true);
+    reader.readInteger("max_steps", render.maxSteps, 1, 1000000);
+    reader.readNumber("detail", render.detail, 0.0, 1000.0, true);
+    if (const Json* value = reader.find("normals"))
+        render.normals = parseChoice(reader, *value, reader.keyPath("normals"), kNormalMethods);
+    if (const Json* value = reader.find("background")) {
+        const std::string key = reader.keyPath("background");
+        if (value->is_array()) {
+            render.backgroundTop = render.backgroundBottom = reader.vec3(*value, key, 0.0, 1000.0);
+        } else {
+            ObjectReader background(*value, key, reader.source());
+            background.readColor("top", render.backgroundTop);
+            background.readColor("bottom", render.backgroundBottom);
+            background.finish();
+        }
+    }
+    reader.finish();
+}
+
+void readOutput(ObjectReader reader, OutputSettings& output) {
+    reader.readString("path", output.path);
+    if (const Json* value = reader.find("format")) output.format = parseChoice(reader, *value, reader.keyPath("format"), kFormats);
+    reader.finish();
+}
+
+/// "line 3, column 5" for a byte offset into the text.
+std::string lineAndColumn(const std::string& text, std::size_t offset) {
+    std::size_t line = 1, column = 1;
+    for (std::size_t index = 0; index < std::min(offset, text.size()); ++index) {
+        if (text[index] == '\n') {
+            ++line;
+            column = 1;
+        } else {
+            ++column;
+        }
+    }
+    return "line " + std::to_string(line) + ", column " + std::to_string(column);
+}
+
+OrderedJson vec3Json(const glm::dvec3& v) { return OrderedJson::array({v.x, v.y, v.z}); }
+OrderedJson vec8Json(const Vec8& v) { return OrderedJson(std::vector<double>(v.begin(), v.end())); }
+
+/// Puts innermost arrays of numbers (vectors, colours) on one line: "[\n  1.0,\n  2.0\n]" -> "[1.0, 2.0]".
+/// Strings are copied untouched.
+std::string compactNumberArrays(const std::string& text) {
+    std::string result;
+    result.reserve(text.size());
+    bool inString = false;
+    for (std::size_t index = 0; index < text.size(); ++index) {
+        const char ch = text[index];
+        if (inString || ch != '[') {
+            if (ch == '"' && (!inString || text[index - 1] != '\\')) inString = !inString;
+            result += ch;
+            continue;
+        }
+        const std::size_t close = text.find_first_of("[]{\"", index + 1);
+        if (close == std::string::npos || text[close] != ']') {
+            result += ch;
+            continue;
+        }
+        result += '[';
+        for (std::size_t inner = index + 1; inner < close; ++inner) {
+            if (text[inner] == '\n' || text[inner] == ' ') continue;
+            result += text[inner];
+            if (text[inner] == ',') result += ' ';
+        }
+        result += ']';
+        index = close;
+    }
+    return result;
+}
+
+bool parallel(const glm::dvec3& a, const glm::dvec3& b) {
+    return glm::length(glm::cross(glm::normalize(a), glm::normalize(b))) < 1e-6;
+}
+
+}  // namespace
+
+Params parseParams(const std::string& jsonText, const std::string& source, Validation validation) {
+    Json document;
+    try {
+        document = Json::parse(jsonText);
+    } catch (const Json::parse_error& error) {
+        std::string reason = error.what();
+        const std::size_t colon = reason.find(": ");  // drop "[json.exception.parse_error.101] parse error at ...: "
+        if (colon != std::string::npos) reason = reason.substr(colon + 2);
+        throw ParamError("", source + ": " + lineAndColumn(jsonText, error.byte == 0 ? 0 : error.byte - 1) +
+                                 ": malformed JSON: " + reason);
+    } catch (const Json::exception& error) {  // e.g. "number overflow parsing '1e999'"
+        std::string reason = error.what();
+        const std::size_t bracket = reason.find("] ");
+        if (bracket != std::string::npos) reason = reason.substr(bracket + 2);
+        throw ParamError("", source + ": malformed JSON: " + reason);
+    }
+    Params params;
+    ObjectReader root(document, "", source);
+    if (const Json* value = root.find("version")) {
+        if (!value->is_number_integer() || value->get<int>() != kFormatVersion)
+            root.fail("version", "this dqjulia reads parameter format version " + std::to_string(kFormatVersion) +
+                                     ", got " + describe(*value));
+    }
+    root.readString("description", params.description);
+    if (const Json* value = root.find("fractal")) readFractal(ObjectReader(*value, "fractal", source), params.fractal);
+    if (const Json* value = root.find("slice")) readSlice(ObjectReader(*value, "slice", source), params.slice);
+    if (const Json* value = root.find("bounds")) {
+        if (!(value->is_string() && value->get<std::string>() == "auto"))
+            readBounds(ObjectReader(*value, "bounds", source), params.bounds);
+    }
+    if (const Json* value = root.find("camera")) readCamera(ObjectReader(*value, "camera", source), params.camera);
+    if (const Json* value = root.find("lights")) readLights(root, *value, params.lights);
+    if (const Json* value = root.find("material")) readMaterial(ObjectReader(*value, "material", source), params.material);
+    if (const Json* value = root.find("render")) readRender(ObjectReader(*value, "render", source), params.render);
+    if (const Json* value = root.find("output")) readOutput(ObjectReader(*value, "output", source), params.output);
+    root.finish();
+    if (validation == Validation::TypesOnly) return params;
+    try {
+        validate(params);
+    } catch (const ParamError& error) {
+        throw ParamError(error.key(), source + ": " + error.what());
+    }
+    return params;
+}
+
+Params loadParams(const std::string& path, Validation validation) {
+    std::ifstream file(path, std::ios::binary);
+    if (!file) throw ParamError("", "cannot read parameter file '" + path + "': " + std::strerror(errno));
+    std::ostringstream text;
+    text << file.rdbuf();
+    if (file.bad()) throw ParamError("", "cannot read parameter file '" + path + "'");
+    return parseParams(text.str(), path, validation);
+}
+
+void validate(const Params& params) {
+    auto fail = [](const std::string& key, const std::string& message) { throw ParamError(key, key + ": " + message); };
+    const Fractal& fractal = params.fractal;
+    for (int index = 0; index < 8; ++index)
+        if (!std::isfinite(component(fractal.c, index))) fail("fractal.c", "every component must be a finite number");
+    if (fractal.iterations < 1 || fractal.iterations > 100000) fail("fractal.iterations", "must be from 1 to 100000");
+    const double needed = minimumBailout(fractal);
+    if (!(fractal.bailout >= needed) || !std::isfinite(fractal.bailout))
+        fail("fractal.bailout", "is " + formatNumber(fractal.bailout) + " but must be at least the containment radius r_K = " +
+                                    formatNumber(needed) + " of this constant (orbits inside r_K may still escape)");
+
+    const Slice slice = params.slice.effective();
+    for (int axis = 0; axis < 3; ++axis)
+        for (int index = 0; index < 8; ++index)
+            if (!std::isfinite(slice.axes[axis][index]) || !std::isfinite(slice.origin[index]))
+                fail("slice", "origin and axes must be finite numbers");
+    for (const PlaneRotation& rotation : params.slice.rotations)
+        if (rotation.first == rotation.second || rotation.first < 0 || rotation.first > 7 || rotation.second < 0 || rotation.second > 7)
+            fail("slice.rotations", "a rotation plane must name two different axes");
+    const Stretch stretch = stretchOf(slice);
+    if (stretch.min < 1e-9 * std::max(1.0, stretch.max))
+        fail("slice.axes", "the three axes are zero or parallel, so the slice is not 3-D; give three independent axes");
+
+    if (params.bounds && !(params.bounds->radius > 0.0)) fail("bounds.radius", "must be greater than 0");
+
+    const Camera& camera = params.camera;
+    if (!(camera.fovDegrees > 0.0 && camera.fovDegrees < 170.0)) fail("camera.fov", "must be between 0 and 170 degrees");
+    if (glm::length(camera.up) == 0.0) fail("camera.up", "must not be the zero vector");
+    glm::dvec3 forward;
+    if (camera.position) {
+        const glm::dvec3 target = camera.target.value_or(glm::dvec3(0.0));
+        forward = target - *camera.position;
+        if (camera.target && glm::length(forward) == 0.0)
+            fail("camera.position", "equals camera.target; the camera must look somewhere");
+    } else {
+        if (glm::length(camera.direction) == 0.0) fail("camera.direction", "must not be the zero vector");
+        forward = -camera.direction;
+    }
+    if (glm::length(forward) > 0.0 && parallel(forward, camera.up))
+        fail("camera.up", "is parallel to the viewing direction; choose an up vector across it");
+
+    for (std::size_t index = 0; index < params.lights.size(); ++index)
+        if (glm::length(params.lights[index].direction) == 0.0)
+            fail("lights[" + std::to_string(index) + "].direction", "must not be the zero vector");
+    if (params.material.palette.empty()) fail("material.palette", "must hold at least one colour");
+
+    const RenderSettings& render = params.render;
+    if (render.width < 1 || render.height < 1 || render.width > 16384 || render.height > 16384)
+        fail("render.width", "width and height must be from 1 to 16384");
+    if (render.samples < 1 || render.samples > 16) fail("render.samples", "must be from 1 to 16");
+    if (!(render.stepFactor > 0.0 && render.stepFactor <= 1.0)) fail("render.step_factor", "must be greater than 0 and at most 1");
+    if (!(render.maxStep > 0.0)) fail("render.max_step", "must be greater than 0");
+    if (render.maxSteps < 1) fail("render.max_steps", "must be at least 1");
+    if (!(render.detail > 0.0)) fail("render.detail", "must be greater than 0");
+    if (render.normals == NormalMethod::Analytic && fractal.variant != Variant::Dual)
+        fail("render.normals", "\"analytic\" normals come from the dual part of the true algebra and need variant \"dual\"; "
+                               "use \"central\" or \"auto\" with variant \"" + std::string(variantName(fractal.variant)) + "\"");
+    if (params.output.path.empty()) fail("output.path", "must not be empty");
+    if (!params.output.format) {
+        std::string extension = params.output.path.substr(std::min(params.output.path.size(), params.output.path.rfind('.')));
+        std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char ch) { return std::tolower(ch); });
+        if (extension != ".png" && extension != ".exr")
+            fail("output.path", "\"" + params.output.path + "\" must end in .png or .exr (or set output.format to png8, png16 or exr)");
+    }
+}
+
+std::string toJson(const Params& params) {
+    OrderedJson document;
+    document["version"] = kFormatVersion;
+    if (!params.description.empty()) document["description"] = params.description;
+    document["fractal"] = {{"c", vec8Json(toVec8(params.fractal.c))},
+                           {"variant", variantName(params.fractal.variant)},
+                           {"iterations", params.fractal.iterations},
+                           {"bailout", params.fractal.bailout}};
+    OrderedJson slice;
+    const std::string names = axisNamesOf(params.slice.base);
+    if (!names.empty()) {
+        slice["axes"] = names;
+    } else {
+        slice["axes"] = OrderedJson::array();
+        for (const Vec8& axis : params.slice.base.axes) slice["axes"].push_back(vec8Json(axis));
+    }
+    slice["origin"] = vec8Json(params.slice.base.origin);
+    slice["rotations"] = OrderedJson::array();
+    for (const PlaneRotation& rotation : params.slice.rotations)
+        slice["rotations"].push_back({{"plane", axisName(rotation.first) + "," + axisName(rotation.second)},
+                                      {"degrees", rotation.degrees}});
+    document["slice"] = slice;
+    if (params.bounds) {
+        document["bounds"] = {{"center", vec3Json(params.bounds->center)}, {"radius", params.bounds->radius}};
+    } else {
+        document["bounds"] = "auto";
+    }
+    OrderedJson camera;
+    if (params.camera.position) camera["position"] = vec3Json(*params.camera.position);
+    if (params.camera.target) camera["target"] = vec3Json(*params.camera.target);
+    camera["direction"] = vec3Json(params.camera.direction);
+    camera["up"] = vec3Json(params.camera.up);
+    camera["fov"] = params.camera.fovDegrees;
+    document["camera"] = camera;
+    document["lights"] = OrderedJson::array();
+    for (const Light& light : params.lights)
+        document["lights"].push_back(
+            {{"direction", vec3Json(light.direction)}, {"color", vec3Json(light.color)}, {"intensity", light.intensity}});
+    const Material& material = params.material;
+    OrderedJson palette = OrderedJson::array();
+    for (const glm::dvec3& color : material.palette) palette.push_back(vec3Json(color));
+    document["material"] = {{"color", vec3Json(material.color)},
+                            {"coloring", coloringName(material.coloring)},
+                            {"palette", palette},
+                            {"ambient", material.ambient},
+                            {"diffuse", material.diffuse},
+                            {"specular", material.specular},
+                            {"shininess", material.shininess},
+                            {"occlusion", material.occlusion},
+                            {"shadows", material.shadows},
+                            {"shadow_softness", material.shadowSoftness}};
+    const RenderSettings& render = params.render;
+    document["render"] = {{"width", render.width},
+                          {"height", render.height},
+                          {"samples", render.samples},
+                          {"step_factor", render.stepFactor},
+                          {"max_step", render.maxStep},
+                          {"max_steps", render.maxSteps},
+                          {"detail", render.detail},
+                          {"normals", normalMethodName(render.normals)},
+                          {"background", {{"top", vec3Json(render.backgroundTop)}, {"bottom", vec3Json(render.backgroundBottom)}}}};
+    OrderedJson output{{"path", params.output.path}};
+    if (params.output.format) output["format"] = imageFormatName(*params.output.format);
+    document["output"] = output;
+    return compactNumberArrays(document.dump(2)) + "\n";
+}
+
+std::string_view coloringName(Coloring coloring) { return nameOf(coloring, kColorings); }
+std::string_view normalMethodName(NormalMethod method) { return nameOf(method, kNormalMethods); }
+std::string_view imageFormatName(ImageFormat format) { return nameOf(format, kFormats); }
+
+ImageFormat formatFor(const OutputSettings& output) {
+    if (output.format) return *output.format;
+    std::string extension;
+    const std::size_t dot = output.path.rfind('.');
+    if (dot != std::string::npos) extension = output.path.substr(dot + 1);
+    std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char ch) { return std::tolower(ch); });
+    return extension == "exr" ? ImageFormat::Exr : ImageFormat::Png8;
+}
+
+}  // namespace dqj

@@ -1,0 +1,184 @@
+/* The C ABI used from a program written in C (not C++): versions, parameters, evaluation
+ * against reference values, errors per handle, rendering with progress and cancel. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "dqjulia/dqjulia.h"
+
+static int failures = 0;
+static int checks = 0;
+
+#define CHECK(condition, ...)                                     \
+    do {                                                          \
+        ++checks;                                                 \
+        if (!(condition)) {                                       \
+            ++failures;                                           \
+            fprintf(stderr, "%s:%d: FAILED: ", __FILE__, __LINE__); \
+            fprintf(stderr, __VA_ARGS__);                         \
+            fprintf(stderr, "\n");                                \
+        }                                                         \
+    } while (0)
+
+static int close_to(double actual, double expected) {
+    if (isinf(expected)) return isinf(actual) && actual > 0;
+    return fabs(actual - expected) <= 1e-10 * fabs(expected);
+}
+
+static const char* c1_paper =
+    "{\"fractal\": {\"c\": [-0.10, 0.8, -0.26, 0.15, -0.23, -0.38, -0.86, 0.64],"
+    " \"variant\": \"paper\", \"iterations\": 15, \"bailout\": 4.0}}";
+
+static int count_calls(double fraction, void* user_data) {
+    int* calls = (int*)user_data;
+    (void)fraction;
+    ++*calls;
+    return 0;
+}
+
+static int cancel_at_once(double fraction, void* user_data) {
+    (void)fraction;
+    (void)user_data;
+    return 1;
+}
+
+static void test_versions(void) {
+    CHECK(dqj_version_number() == DQJ_VERSION_NUMBER, "run-time version %u differs from header %d", dqj_version_number(),
+          DQJ_VERSION_NUMBER);
+    CHECK(strlen(dqj_version_string()) >= 5, "version string too short");
+    CHECK(strcmp(dqj_status_string(DQJ_ERROR_INVALID_HANDLE), "invalid handle") == 0, "status text");
+}
+
+static void test_reference_values(dqj_context context) {
+    /* Rows of reference_vectors.csv: c1 point 1 (0.3 0.2 0.1 0 | 0) and point 0. */
+    const double points[16] = {0.3, 0.2, 0.1, 0.0, 0.0, 0.0, 0.0, 0.0, 0, 0, 0, 0, 0, 0, 0, 0};
+    dqj_sample out[2];
+    CHECK(dqj_context_set_params_json(context, c1_paper) == DQJ_OK, "set params: %s", dqj_context_error(context));
+    CHECK(dqj_evaluate_points(context, points, 2, out) == DQJ_OK, "evaluate: %s", dqj_context_error(context));
+    CHECK(out[0].n == 6 && close_to(out[0].r, 7.214903863267726) && close_to(out[0].ra, 0.8260141247850684) && isinf(out[0].de),
+          "c1 point 1 paper: n=%d r=%.17g de=%g", out[0].n, out[0].r, out[0].de);
+    CHECK(out[1].n == 6 && isinf(out[1].de), "c1 point 0 paper: n=%d", out[1].n);
+
+    CHECK(dqj_context_set_variant(context, DQJ_VARIANT_DUAL) == DQJ_OK, "set variant");
+    CHECK(dqj_evaluate_points(context, points, 1, out) == DQJ_OK, "evaluate dual");
+    CHECK(out[0].n == 14 && close_to(out[0].de, 0.004513454803138481) && close_to(out[0].rb, 250.4132804916606),
+          "c1 point 1 dual: n=%d de=%.17g", out[0].n, out[0].de);
+
+    CHECK(dqj_context_set_variant(context, DQJ_VARIANT_PAPER_COUPLED) == DQJ_OK, "set variant");
+    CHECK(dqj_evaluate_points(context, points, 1, out) == DQJ_OK, "evaluate coupled");
+    CHECK(out[0].n == 6 && close_to(out[0].de, 0.00886741806074376) && close_to(out[0].r, 7.262033949971592),
+          "c1 point 1 paper-coupled: n=%d de=%.17g", out[0].n, out[0].de);
+
+    /* Slice coordinates: the default slice maps (x, y, z) to a.s, a.i, a.j. */
+    {
+        const double xyz[3] = {0.3, 0.2, 0.1};
+        CHECK(dqj_evaluate_slice_points(context, xyz, 1, out) == DQJ_OK, "evaluate slice");
+        CHECK(out[0].n == 6 && close_to(out[0].de, 0.00886741806074376), "slice point: n=%d", out[0].n);
+    }
+}
+
+static void test_errors(dqj_context context) {
+    dqj_sample out[1];
+    const double point[8] = {0};
+    char small[4];
+    size_t needed = 0;
+    dqj_context other = NULL;
+
+    CHECK(dqj_context_set_iterations(context, 0) == DQJ_ERROR_PARAMETERS, "iterations 0 accepted");
+    CHECK(strstr(dqj_context_error(context), "fractal.iterations") != NULL, "message names the key: %s",
+          dqj_context_error(context));
+    CHECK(dqj_context_set_bailout(context, 1.2) == DQJ_ERROR_PARAMETERS, "bailout below r_K accepted");
+    CHECK(strstr(dqj_context_error(context), "containment radius") != NULL, "bailout message: %s", dqj_context_error(context));
+    CHECK(dqj_context_set_slice_axes(context, "a.s,a.s,a.j") == DQJ_ERROR_INVALID_ARGUMENT, "repeated axis accepted");
+    CHECK(dqj_context_set_params_json(context, "{\"fractal\": {\"iteratons\": 5}}") == DQJ_ERROR_PARAMETERS, "typo accepted");
+    CHECK(strstr(dqj_context_error(context), "did you mean \"iterations\"") != NULL, "no suggestion: %s",
+          dqj_context_error(context));
+    CHECK(dqj_context_set_params_json(context, "{\"fractal\": ") == DQJ_ERROR_PARAMETERS, "bad JSON accepted");
+    CHECK(strstr(dqj_context_error(context), "line 1") != NULL, "no line number: %s", dqj_context_error(context));
+    CHECK(dqj_evaluate_points(context, NULL, 1, out) == DQJ_ERROR_INVALID_ARGUMENT, "NULL points accepted");
+    CHECK(dqj_context_get_params_json(context, small, sizeof small, &needed) == DQJ_ERROR_INVALID_ARGUMENT, "small buffer");
+    CHECK(needed > 100, "size query gave %zu", needed);
+
+    /* Handles: null, destroyed and garbage handles are rejected, not dereferenced. */
+    CHECK(dqj_evaluate_points(NULL, point, 1, out) == DQJ_ERROR_INVALID_HANDLE, "NULL handle accepted");
+    CHECK(dqj_context_create(&other) == DQJ_OK && other != NULL, "create");
+    dqj_context_destroy(other);
+    CHECK(dqj_evaluate_points(other, point, 1, out) == DQJ_ERROR_INVALID_HANDLE, "destroyed handle accepted");
+    CHECK(dqj_context_error(other)[0] != '\0', "no message for a destroyed handle");
+    dqj_context_destroy(other); /* twice: ignored */
+    CHECK(dqj_evaluate_points((dqj_context)(void*)&needed, point, 1, out) == DQJ_ERROR_INVALID_HANDLE, "garbage handle");
+    CHECK(dqj_context_create(NULL) == DQJ_ERROR_INVALID_ARGUMENT, "create(NULL)");
+
+    /* A failed call leaves the previous parameters in place. */
+    {
+        char* json;
+        CHECK(dqj_context_get_params_json(context, NULL, 0, &needed) == DQJ_OK, "size query");
+        json = (char*)malloc(needed);
+        CHECK(dqj_context_get_params_json(context, json, needed, NULL) == DQJ_OK, "get params");
+        CHECK(strstr(json, "\"paper-coupled\"") != NULL, "parameters changed by a failed call: %s", json);
+        free(json);
+    }
+}
+
+static void test_render(dqj_context context, const char* scratch_dir) {
+    /* c = 0 under the true algebra is the unit ball, centred in the picture. */
+    const double zero[8] = {0};
+    enum { W = 64, H = 48 };
+    static unsigned char pixels[W * H * 4];
+    int calls = 0;
+    char path[1024];
+    FILE* file;
+
+    CHECK(dqj_context_set_params_json(context, "{\"fractal\": {\"variant\": \"dual\"}}") == DQJ_OK, "params: %s",
+          dqj_context_error(context));
+    CHECK(dqj_context_set_constant(context, zero) == DQJ_OK, "constant: %s", dqj_context_error(context));
+    CHECK(dqj_render_rgba8(context, pixels, W, H, W * 4, count_calls, &calls) == DQJ_OK, "render: %s",
+          dqj_context_error(context));
+    CHECK(pixels[((H / 2) * W + W / 2) * 4 + 3] == 255, "centre pixel not covered");
+    CHECK(pixels[3] == 0, "corner pixel covered");
+    CHECK(calls >= 1, "progress never called");
+    CHECK(dqj_context_warning(context)[0] == '\0', "warning for a non-empty render: %s", dqj_context_warning(context));
+    CHECK(dqj_render_rgba8(context, pixels, W, H, W * 4, cancel_at_once, NULL) == DQJ_ERROR_CANCELLED, "cancel ignored");
+    CHECK(dqj_render_rgba8(context, pixels, W, H, W * 2, NULL, NULL) == DQJ_ERROR_INVALID_ARGUMENT, "short stride accepted");
+
+    /* Writing into a folder that does not exist fails cleanly and leaves nothing behind. */
+    snprintf(path, sizeof path, "%s/no-such-folder/x.png", scratch_dir);
+    CHECK(dqj_render_to_file(context, path, NULL, NULL) == DQJ_ERROR_IO, "missing folder: %s", dqj_context_error(context));
+    file = fopen(path, "rb");
+    CHECK(file == NULL, "a file appeared");
+    if (file) fclose(file);
+}
+
+static void test_empty_slice(dqj_context context) {
+    /* The paper's first constant: its dual part is outside the Mandelbrot set, so with b fixed
+     * at 0 the slice is empty for N >= 6; the library must say so. */
+    char* json;
+    size_t needed = 0;
+    enum { W = 16, H = 12 };
+    static unsigned char pixels[W * H * 4];
+    CHECK(dqj_context_set_params_json(context, c1_paper) == DQJ_OK, "params: %s", dqj_context_error(context));
+    CHECK(dqj_inspect_json(context, NULL, 0, &needed) == DQJ_OK, "inspect size");
+    json = (char*)malloc(needed);
+    CHECK(dqj_inspect_json(context, json, needed, NULL) == DQJ_OK, "inspect");
+    CHECK(strstr(json, "\"empty\": true") != NULL, "not reported empty: %s", json);
+    CHECK(strstr(json, "outside the Mandelbrot set") != NULL, "no reason: %s", json);
+    free(json);
+    CHECK(dqj_render_rgba8(context, pixels, W, H, W * 4, NULL, NULL) == DQJ_OK, "render empty");
+    CHECK(strstr(dqj_context_warning(context), "N >= 6") != NULL, "empty render without reason: '%s'",
+          dqj_context_warning(context));
+}
+
+int main(int argc, char** argv) {
+    dqj_context context = NULL;
+    const char* scratch = argc > 1 ? argv[1] : ".";
+    test_versions();
+    CHECK(dqj_context_create(&context) == DQJ_OK, "create");
+    test_reference_values(context);
+    test_errors(context);
+    test_render(context, scratch);
+    test_empty_slice(context);
+    dqj_context_destroy(context);
+    printf("%d passed, %d failed\n", checks - failures, failures);
+    return failures == 0 ? 0 : 1;
+}
