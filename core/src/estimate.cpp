@@ -103,7 +103,11 @@ double containmentRadius(const Quat& c) { return 0.5 * (1.0 + std::sqrt(1.0 + 4.
 double minimumBailout(const Fractal& fractal) {
     const double realRadius = containmentRadius(fractal.c.a);
     if (fractal.variant == Variant::Dual) return realRadius;  // only |a| is tested
-    return std::max(realRadius, containmentRadius(fractal.c.b));
+    const double dualRadius = containmentRadius(fractal.c.b);
+    // One 8-D norm: sqrt(|a|^2 + |b|^2) > R must imply |a| > r_K(c_a) or |b| > r_K(c_b),
+    // else points of the set (both parts just inside their r_K) would count as escaped.
+    if (fractal.variant == Variant::PaperCoupled) return std::hypot(realRadius, dualRadius);
+    return std::max(realRadius, dualRadius);
 }
 
 glm::dvec3 realPartGradient(const Fractal& fractal, const Quat& start, const Quat directions[3]) {

@@ -196,8 +196,15 @@ void writeExr(const Image& image, const std::string& path) {
     const std::size_t pixels = width * height;
     // Colours as HALF (ample for display-referred linear light); depth and normals as FLOAT,
     // since compositing (depth of field, relighting) needs their precision.
-    std::vector<half> rgba(image.rgba.size());
-    for (std::size_t index = 0; index < rgba.size(); ++index) rgba[index] = half(image.rgba[index]);
+    // RGB is the surface alone, premultiplied by alpha, so the fractal composites over any
+    // plate (an image without a separate surface pass falls back to its full colour).
+    const bool haveSurface = image.surface.size() == 3 * pixels;
+    std::vector<half> rgba(4 * pixels);
+    for (std::size_t pixel = 0; pixel < pixels; ++pixel) {
+        for (int channel = 0; channel < 3; ++channel)
+            rgba[4 * pixel + channel] = half(haveSurface ? image.surface[3 * pixel + channel] : image.rgba[4 * pixel + channel]);
+        rgba[4 * pixel + 3] = half(image.rgba[4 * pixel + 3]);
+    }
     // Misses have depth +inf in memory; in the file they get 1e10, as Blender writes for its
     // background, because infinities break many compositing nodes.
     std::vector<float> depth(image.depth);

@@ -327,6 +327,7 @@ TileStats renderTile(const Scene& scene, int x0, int y0, int x1, int y1, Image& 
     for (int y = y0; y < y1; ++y) {
         for (int x = x0; x < x1; ++x) {
             glm::dvec3 colour(0.0);
+            glm::dvec3 surfaceColour(0.0);
             glm::dvec3 normalSum(0.0);
             double depth = kInfinity;
             int hits = 0;
@@ -346,7 +347,9 @@ TileStats renderTile(const Scene& scene, int x0, int y0, int x1, int y1, Image& 
                     const glm::dvec3 p = camera.eye + trace.t * direction;
                     const double eps = scene.epsilon(trace.t);
                     const glm::dvec3 normal = scene.normalAt(p, direction, trace, eps);
-                    colour += scene.shade(p, normal, direction, trace.escape, eps);
+                    const glm::dvec3 shaded = scene.shade(p, normal, direction, trace.escape, eps);
+                    colour += shaded;
+                    surfaceColour += shaded;
                     normalSum += normal;
                     depth = std::min(depth, trace.t);
                     ++hits;
@@ -354,6 +357,9 @@ TileStats renderTile(const Scene& scene, int x0, int y0, int x1, int y1, Image& 
             }
             const std::size_t pixel = static_cast<std::size_t>(y) * image.width + x;
             colour *= weight;
+            surfaceColour *= weight;
+            for (int channel = 0; channel < 3; ++channel)
+                image.surface[3 * pixel + channel] = static_cast<float>(surfaceColour[channel]);
             image.rgba[4 * pixel + 0] = static_cast<float>(colour.x);
             image.rgba[4 * pixel + 1] = static_cast<float>(colour.y);
             image.rgba[4 * pixel + 2] = static_cast<float>(colour.z);
@@ -436,6 +442,7 @@ RenderResult render(const Params& params, const ProgressCallback& progress) {
     image.height = scene.camera().height;
     const std::size_t pixels = static_cast<std::size_t>(image.width) * image.height;
     image.rgba.assign(4 * pixels, 0.0f);
+    image.surface.assign(3 * pixels, 0.0f);
     image.depth.assign(pixels, std::numeric_limits<float>::infinity());
     image.normal.assign(3 * pixels, 0.0f);
 

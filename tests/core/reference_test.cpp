@@ -74,7 +74,8 @@ ReferenceFile loadReference() {
         std::stringstream stream(text);
         for (std::string field; std::getline(stream, field, ',');) fields.push_back(field);
         try {
-            if (fields.size() != 14) throw std::runtime_error("expected 14 columns, got " + std::to_string(fields.size()));
+            if (fields.size() != 14)
+                throw std::runtime_error("expected 14 columns, got " + std::to_string(fields.size()));
             ReferenceRow row;
             row.line = line;
             row.constant = fields[0];
@@ -146,6 +147,36 @@ TEST_P(ReferenceVectors, MatchesEvaluate) {
         expectClose(actual[index], expected[index], what.c_str());
     }
     EXPECT_EQ(dqj::distanceEstimate(fractal, row.start), result.de);
+}
+
+// r_K and the smallest allowed bailout (math.md, "Containment radius").
+TEST(ReferenceContainment, RadiusAndMinimumBailout) {
+    EXPECT_EQ(dqj::containmentRadius(dqj::makeQuat(0, 0, 0, 0)), 1.0);
+    EXPECT_DOUBLE_EQ(dqj::containmentRadius(dqj::makeQuat(0, 0, 0, -2)), 2.0);  // (1 + sqrt(9)) / 2
+    EXPECT_DOUBLE_EQ(dqj::containmentRadius(dqj::makeQuat(0.5, 0.5, 0.5, 0.5)), 0.5 * (1.0 + std::sqrt(5.0)));
+
+    dqj::Fractal fractal;
+    fractal.c = {dqj::makeQuat(0, 0, 0, -2), dqj::makeQuat(0, 0, 0, 0)};  // r_K = 2 and 1
+    fractal.variant = dqj::Variant::Dual;
+    EXPECT_DOUBLE_EQ(dqj::minimumBailout(fractal), 2.0);  // only |a| is tested
+    fractal.variant = dqj::Variant::Paper;
+    EXPECT_DOUBLE_EQ(dqj::minimumBailout(fractal), 2.0);  // max(2, 1)
+    fractal.variant = dqj::Variant::PaperCoupled;
+    EXPECT_DOUBLE_EQ(dqj::minimumBailout(fractal), std::sqrt(5.0));  // one norm over both parts
+}
+
+// With R at the minimum, no point of the set may count as escaped. c = 0: K(0) x K(0) holds
+// (0.9, 0.9), whose orbit tends to 0, but its 8-D norm 1.15 exceeds max(r_K) = 1.
+TEST(ReferenceContainment, MinimumBailoutKeepsSetPointsInside) {
+    const dqj::DualQuat start{dqj::makeQuat(0.9, 0, 0, 0), dqj::makeQuat(0, 0.9, 0, 0)};
+    for (dqj::Variant variant : {dqj::Variant::Paper, dqj::Variant::PaperCoupled, dqj::Variant::Dual}) {
+        dqj::Fractal fractal;
+        fractal.c = {};
+        fractal.variant = variant;
+        fractal.iterations = 100;
+        fractal.bailout = dqj::minimumBailout(fractal);
+        EXPECT_EQ(dqj::evaluate(fractal, start).n, 0) << dqj::variantName(variant);
+    }
 }
 
 std::string rowName(const testing::TestParamInfo<ReferenceRow>& info) {

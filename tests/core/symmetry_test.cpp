@@ -121,7 +121,7 @@ DualQuat samplePoint(const Fractal& fractal, int index, DualQuat direction) {
 
 /// A point whose escape count changes under perturbations far larger than rounding: some
 /// iterate sits within rounding of the bailout sphere, so a symmetry that only holds up to
-/// rounding may legitimately change its count (or its DE).
+/// rounding may legitimately change its count there.
 bool nearBailout(const Fractal& fractal, const DualQuat& z, const Escape& reference, Random& random) {
     for (int trial = 0; trial < 4; ++trial) {
         DualQuat moved = z;

@@ -12,11 +12,13 @@
 namespace dqj {
 
 /// Row-major, top row first. Colours are linear RGB; files get the sRGB transfer (PNG) or
-/// stay linear (EXR).
+/// stay linear (EXR). PNG files hold `rgba`'s colour (the background included, opaque); EXR
+/// files hold `surface` with alpha (premultiplied, transparent background), depth and normals.
 struct Image {
     int width = 0;
     int height = 0;
-    std::vector<float> rgba;    ///< 4 per pixel; alpha = fraction of the pixel's samples that hit
+    std::vector<float> rgba;    ///< 4 per pixel: the picture over the background; alpha = fraction of samples that hit
+    std::vector<float> surface; ///< 3 per pixel: the surface alone, premultiplied by alpha (EXR's RGB, for compositing)
     std::vector<float> depth;   ///< 1 per pixel: distance from the eye to the nearest hit, +inf if none
     std::vector<float> normal;  ///< 3 per pixel: unit surface normal in slice coordinates, 0 if none
 };
