@@ -6,6 +6,6 @@ cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 scripts/build.sh
 mkdir -p out
-build/bin/dqjulia render -o out/dqjulia.png
+build/bin/dqjulia render --force -o out/dqjulia.png
 build/bin/dqjulia inspect > out/dqjulia-inspect.txt
 echo "dqjulia: wrote out/dqjulia.png (and out/dqjulia-inspect.txt); try: build/bin/dqjulia render --help"

@@ -6,6 +6,7 @@
 #include <chrono>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 
 #include "dqjulia/estimate.hpp"
@@ -107,6 +108,21 @@ Params FractalOptions::load() const {
     applyTo(params);
     validate(params);
     return params;
+}
+
+void checkOutputPath(const std::string& path, bool force, const std::string& flag) {
+    namespace fs = std::filesystem;
+    std::error_code error;
+    const fs::path target(path);
+    if (fs::is_directory(target, error))
+        throw ParamError("output.path", flag + " '" + path + "' is a folder; give a file name");
+    if (fs::exists(target, error) && !force)
+        throw ParamError("output.path", flag + " '" + path + "' exists; pass --force to overwrite it");
+    const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
+    if (!fs::is_directory(folder, error))
+        throw ParamError("output.path", flag + " '" + path + "': the folder '" + folder.string() + "' does not exist");
+    if (::access(folder.c_str(), W_OK) != 0)
+        throw ParamError("output.path", flag + " '" + path + "': the folder '" + folder.string() + "' is not writable");
 }
 
 int reportErrors(const std::string& command, const std::function<int()>& body) {

@@ -34,6 +34,10 @@ struct FractalOptions {
     void applyTo(Params& params) const;
 };
 
+/// Checks an output path before any long work starts: refuses an existing file unless `force`,
+/// and a folder that is missing or not writable. Throws ParamError naming `flag`.
+void checkOutputPath(const std::string& path, bool force, const std::string& flag = "--output");
+
 /// Runs `body`, printing "dqjulia: <message>" for errors and returning the exit code.
 int reportErrors(const std::string& command, const std::function<int()>& body);
 

@@ -23,6 +23,7 @@ struct RenderOptions {
     std::string saveParams;
     bool quiet = false;
     bool stats = false;
+    bool force = false;
 };
 
 Params loadRenderParams(const RenderOptions& options) {
@@ -61,10 +62,10 @@ Params loadRenderParams(const RenderOptions& options) {
 
 int runRender(const RenderOptions& options) {
     const Params params = loadRenderParams(options);
+    checkOutputPath(params.output.path, options.force);
     if (!options.saveParams.empty()) {
-        std::ofstream file(options.saveParams);
-        file << toJson(params);
-        if (!file.flush()) throw std::runtime_error("cannot write '" + options.saveParams + "'");
+        checkOutputPath(options.saveParams, options.force, "--save-params");
+        saveParams(params, options.saveParams);
     }
     // Say up front when the slice is provably empty: an empty picture needs a reason.
     const std::string provenEmpty = provenEmptyReason(params);
@@ -118,6 +119,7 @@ Runner addRenderCommand(CLI::App& app) {
     command->add_option("--camera-position", options->cameraPosition, "Camera position x y z")->expected(3);
     command->add_option("--camera-target", options->cameraTarget, "Camera target x y z")->expected(3);
     command->add_option("--save-params", options->saveParams, "Also write the complete parameter file used");
+    command->add_flag("-f,--force", options->force, "Overwrite existing output files");
     command->add_flag("-q,--quiet", options->quiet, "No progress bar or summary");
     command->add_flag("--stats", options->stats, "Print ray and step counts to stdout");
     return [options] { return reportErrors("render", [&] { return runRender(*options); }); };

@@ -180,12 +180,16 @@ void writePng(const Image& image, const std::string& path, int bitDepth) {
     std::FILE* file = std::fopen(target.tempPath().c_str(), "wb");
     if (!file) throw std::runtime_error(AtomicFile::failureMessage(path, std::strerror(errno)));
     PngError error;
+    errno = 0;
     const bool written = writePngRows(file, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height),
                                       bitDepth, rows.data(), &error);
+    const int writeErrno = errno;  // libpng's "Write Error" does not say why; fwrite's errno does
     // fclose flushes: a full disk shows up here, not in libpng.
     const bool flushed = std::fflush(file) == 0 && !std::ferror(file);
     const int closeError = std::fclose(file) == 0 ? 0 : errno;
-    if (!written) throw std::runtime_error(AtomicFile::failureMessage(path, error.message));
+    if (!written)
+        throw std::runtime_error(AtomicFile::failureMessage(
+            path, std::string(error.message) + (writeErrno ? std::string(": ") + std::strerror(writeErrno) : "")));
     if (!flushed || closeError) throw std::runtime_error(AtomicFile::failureMessage(path, std::strerror(closeError ? closeError : EIO)));
     target.commit();
 }

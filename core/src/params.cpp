@@ -12,6 +12,8 @@
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
 
+#include "atomic_file.hpp"
+
 namespace dqj {
 
 ParamError::ParamError(std::string key, const std::string& message)
@@ -447,7 +449,7 @@ void validate(const Params& params) {
     const double needed = minimumBailout(fractal);
     if (!(fractal.bailout >= needed) || !std::isfinite(fractal.bailout))
         fail("fractal.bailout", "is " + formatNumber(fractal.bailout) + " but must be at least the containment radius r_K = " +
-                                    formatNumber(needed) + " of this constant (orbits inside r_K may still escape)");
+                                    formatNumber(needed) + " of this constant and variant (points inside r_K may still be in the set)");
 
     const Slice slice = params.slice.effective();
     for (int axis = 0; axis < 3; ++axis)
@@ -569,6 +571,17 @@ std::string toJson(const Params& params) {
     if (params.output.format) output["format"] = imageFormatName(*params.output.format);
     document["output"] = output;
     return compactNumberArrays(document.dump(2)) + "\n";
+}
+
+void saveParams(const Params& params, const std::string& path) {
+    AtomicFile target(path);
+    {
+        std::ofstream file(target.tempPath(), std::ios::binary | std::ios::trunc);
+        file << toJson(params);
+        file.flush();
+        if (!file) throw std::runtime_error(AtomicFile::failureMessage(path, std::strerror(errno)));
+    }
+    target.commit();
 }
 
 std::string_view coloringName(Coloring coloring) { return nameOf(coloring, kColorings); }

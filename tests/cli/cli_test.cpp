@@ -200,15 +200,26 @@ TEST_F(Cli, BadInputGetsOneClearMessageAndWritesNothing) {
     }
 }
 
-TEST_F(Cli, UnwritableOutputFailsWithoutPartialFiles) {
+TEST_F(Cli, UnwritableOutputFailsBeforeWorkWithoutPartialFiles) {
     const Outcome result = run("render -q -W 16 -H 12 -o '" + path("missing/dir/x.png") + "'");
-    EXPECT_EQ(result.exitCode, 1);
-    EXPECT_NE(result.err.find("missing/dir/x.png"), std::string::npos) << result.err;
+    EXPECT_EQ(result.exitCode, 2);
+    EXPECT_NE(result.err.find("the folder '" + path("missing/dir") + "' does not exist"), std::string::npos) << result.err;
     EXPECT_FALSE(fs::exists(path("missing")));
     // An existing image is left intact when a render into it fails validation.
     const std::string existing = write("keep.png", "precious");
     EXPECT_EQ(run("render -n 0 -o '" + existing + "'").exitCode, 2);
     EXPECT_EQ(readFile(existing), "precious");
+}
+
+TEST_F(Cli, ExistingOutputIsRefusedUnlessForced) {
+    const std::string existing = write("keep.png", "precious");
+    const Outcome refused = run("render -q -W 16 -H 12 -o '" + existing + "'");
+    EXPECT_EQ(refused.exitCode, 2);
+    EXPECT_NE(refused.err.find("exists; pass --force to overwrite it"), std::string::npos) << refused.err;
+    EXPECT_EQ(readFile(existing), "precious");
+    const Outcome forced = run("render -q -W 16 -H 12 --force -o '" + existing + "'");
+    EXPECT_EQ(forced.exitCode, 0) << forced.err;
+    EXPECT_EQ(dqj::readPng(existing).width, 16);
 }
 
 TEST_F(Cli, ExamplesAreValidParameterFiles) {

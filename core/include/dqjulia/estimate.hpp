@@ -44,7 +44,9 @@ DQJ_API double distanceEstimate(const Fractal& fractal, const DualQuat& start);
 /// Any quaternion orbit with |q| > r_K(c) = (1 + sqrt(1 + 4|c|)) / 2 escapes.
 DQJ_API double containmentRadius(const Quat& c);
 
-/// The smallest bailout the fractal allows: r_K of each part that takes part in the escape test.
+/// The smallest bailout the fractal allows: the largest r_K of the parts tested for escape
+/// (paper: both parts; dual: a only); for paper-coupled's single 8-D norm, hypot(r_K(c_a), r_K(c_b)),
+/// so that an 8-D norm above R forces one part past its own r_K.
 DQJ_API double minimumBailout(const Fractal& fractal);
 
 /// Gradient of ln|a_n| with respect to the real part of the start point, along three

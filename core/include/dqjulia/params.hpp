@@ -114,6 +114,9 @@ DQJ_API Params parseParams(const std::string& jsonText, const std::string& sourc
 DQJ_API Params loadParams(const std::string& path, Validation validation = Validation::Full);
 /// The complete document for `params` (every key written), which parseParams reads back.
 DQJ_API std::string toJson(const Params& params);
+/// Writes toJson(params) to `path` through a temporary file in the same folder, so a failure
+/// never leaves a partial file. Throws std::runtime_error naming the path.
+DQJ_API void saveParams(const Params& params, const std::string& path);
 /// Checks the cross-field rules (bailout >= r_K, non-degenerate slice, camera, ...). Throws ParamError.
 DQJ_API void validate(const Params& params);
 

@@ -1,0 +1,192 @@
+// Robustness: interrupted work and full disks lose nothing; the C ABI works from many threads.
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/mount.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <thread>
+#include <vector>
+
+#include "dqjulia/dqjulia.h"
+
+extern char** environ;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string readFile(const fs::path& path) {
+    std::ifstream file(path, std::ios::binary);
+    std::ostringstream text;
+    text << file.rdbuf();
+    return text.str();
+}
+
+/// A scratch folder per test.
+class Scratch : public ::testing::Test {
+protected:
+    void SetUp() override {
+        dir_ = fs::temp_directory_path() / ("dqjulia_robust_" + std::to_string(::getpid()) + "_" +
+                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+    }
+    void TearDown() override {
+        if (mounted_) ::umount(dir_.c_str());
+        fs::remove_all(dir_);
+    }
+    std::vector<std::string> filesIn(const fs::path& folder) const {
+        std::vector<std::string> names;
+        for (const auto& entry : fs::directory_iterator(folder)) names.push_back(entry.path().filename().string());
+        return names;
+    }
+
+    fs::path dir_;
+    bool mounted_ = false;
+};
+
+/// Starts the CLI with `arguments`, stdout/stderr to files in `folder`; returns its pid.
+pid_t spawnCli(const std::vector<std::string>& arguments, const fs::path& errPath) {
+    std::vector<std::string> all{DQJ_CLI};
+    all.insert(all.end(), arguments.begin(), arguments.end());
+    std::vector<char*> argv;
+    for (std::string& argument : all) argv.push_back(argument.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 2, errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    pid_t pid = -1;
+    const int status = posix_spawn(&pid, DQJ_CLI, &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    return status == 0 ? pid : -1;
+}
+
+int waitExit(pid_t pid) {
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+class Interrupt : public Scratch, public ::testing::WithParamInterface<int> {};
+
+TEST_P(Interrupt, StopsARenderPromptlyAndKeepsThePreviousOutput) {
+    const fs::path output = dir_ / "picture.png";
+    std::ofstream(output) << "previous picture";
+    // Long enough to be interrupted: several seconds of work on 2 cores.
+    const pid_t pid = spawnCli({"render", "--force", "-W", "1600", "-H", "1200", "-s", "4", "-o", output.string()},
+                               dir_ / "stderr.txt");
+    ASSERT_GT(pid, 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    const auto sent = std::chrono::steady_clock::now();
+    ASSERT_EQ(::kill(pid, GetParam()), 0);
+    const int exitCode = waitExit(pid);
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
+    EXPECT_EQ(exitCode, 130) << readFile(dir_ / "stderr.txt");
+    EXPECT_LT(seconds, 2.0) << "the render did not stop promptly";
+    EXPECT_NE(readFile(dir_ / "stderr.txt").find("interrupted; nothing was written"), std::string::npos);
+    EXPECT_EQ(readFile(output), "previous picture");
+    EXPECT_EQ(filesIn(dir_).size(), 2u);  // picture.png and stderr.txt only
+    for (const std::string& name : filesIn(dir_)) EXPECT_EQ(name.find(".tmp"), std::string::npos) << name;
+}
+
+INSTANTIATE_TEST_SUITE_P(Signals, Interrupt, ::testing::Values(SIGINT, SIGTERM),
+                         [](const auto& info) { return info.param == SIGINT ? "SIGINT" : "SIGTERM"; });
+
+TEST_F(Scratch, FullDiskIsReportedAndLeavesNothing) {
+    const fs::path disk = dir_ / "tiny";
+    fs::create_directories(disk);
+    if (::mount("tmpfs", disk.c_str(), "tmpfs", 0, "size=32k") != 0)
+        GTEST_SKIP() << "cannot mount a small tmpfs here (" << std::strerror(errno) << "); needs root";
+    mounted_ = true;
+    const fs::path output = disk / "big.png";
+    const pid_t pid = spawnCli({"render", "-q", "-W", "640", "-H", "480", "-o", output.string()}, dir_ / "stderr.txt");
+    ASSERT_GT(pid, 0);
+    EXPECT_EQ(waitExit(pid), 1);
+    const std::string err = readFile(dir_ / "stderr.txt");
+    EXPECT_NE(err.find("No space left on device"), std::string::npos) << err;
+    EXPECT_TRUE(filesIn(disk).empty()) << "left behind: " << (filesIn(disk).empty() ? "" : filesIn(disk).front());
+    ::umount(disk.c_str());
+    mounted_ = false;
+}
+
+// --- The C ABI from many threads -------------------------------------------------------
+
+constexpr int kThreads = 8;
+
+std::vector<dqj_sample> evaluateGrid(dqj_context context) {
+    std::vector<double> points;
+    for (int i = 0; i < 2000; ++i) {
+        const double t = i / 2000.0;
+        points.insert(points.end(), {std::cos(7 * t) * 1.2, std::sin(5 * t) * 1.1, t - 0.5});
+    }
+    std::vector<dqj_sample> out(points.size() / 3);
+    EXPECT_EQ(dqj_evaluate_slice_points(context, points.data(), out.size(), out.data()), DQJ_OK);
+    return out;
+}
+
+TEST(ConcurrentContexts, GiveTheSameResultsAsOneThread) {
+    dqj_context reference = nullptr;
+    ASSERT_EQ(dqj_context_create(&reference), DQJ_OK);
+    const std::vector<dqj_sample> expectedSamples = evaluateGrid(reference);
+    std::vector<unsigned char> expectedImage(48 * 36 * 4);
+    ASSERT_EQ(dqj_render_rgba8(reference, expectedImage.data(), 48, 36, 48 * 4, nullptr, nullptr), DQJ_OK);
+    dqj_context_destroy(reference);
+
+    std::vector<int> failures(kThreads, 0);
+    std::vector<std::thread> threads;
+    for (int index = 0; index < kThreads; ++index) {
+        threads.emplace_back([&, index] {
+            for (int round = 0; round < 3; ++round) {
+                dqj_context context = nullptr;
+                if (dqj_context_create(&context) != DQJ_OK) {
+                    ++failures[index];
+                    continue;
+                }
+                // Each thread also makes its own errors: they stay on its own handle.
+                if (dqj_context_set_iterations(context, -1) != DQJ_ERROR_PARAMETERS ||
+                    std::strstr(dqj_context_error(context), "fractal.iterations") == nullptr)
+                    ++failures[index];
+                const std::vector<dqj_sample> samples = evaluateGrid(context);
+                for (std::size_t i = 0; i < samples.size(); ++i)
+                    if (samples[i].n != expectedSamples[i].n || samples[i].de != expectedSamples[i].de) ++failures[index];
+                std::vector<unsigned char> image(expectedImage.size());
+                if (dqj_render_rgba8(context, image.data(), 48, 36, 48 * 4, nullptr, nullptr) != DQJ_OK || image != expectedImage)
+                    ++failures[index];
+                dqj_context_destroy(context);
+            }
+        });
+    }
+    for (std::thread& thread : threads) thread.join();
+    for (int index = 0; index < kThreads; ++index) EXPECT_EQ(failures[index], 0) << "thread " << index;
+}
+
+TEST(ConcurrentContexts, HandlesCreatedAndDestroyedConcurrentlyStayValid) {
+    // Create and destroy from many threads while checking that destroyed handles are refused.
+    std::vector<int> failures(kThreads, 0);
+    std::vector<std::thread> threads;
+    for (int index = 0; index < kThreads; ++index) {
+        threads.emplace_back([&, index] {
+            for (int round = 0; round < 500; ++round) {
+                dqj_context context = nullptr;
+                if (dqj_context_create(&context) != DQJ_OK) ++failures[index];
+                const double point[8] = {0.1, 0.2, 0, 0, 0, 0, 0, 0};
+                dqj_sample sample;
+                if (dqj_evaluate_points(context, point, 1, &sample) != DQJ_OK) ++failures[index];
+                dqj_context_destroy(context);
+            }
+        });
+    }
+    for (std::thread& thread : threads) thread.join();
+    for (int index = 0; index < kThreads; ++index) EXPECT_EQ(failures[index], 0) << "thread " << index;
+}
+
+}  // namespace
