@@ -1,7 +1,16 @@
 #!/usr/bin/env bash
-# The README's second command: install what is missing, build, and run every test.
+# The README's second command: install what is missing, build, and run every test:
+# first the Release build, then the whole suite again built with clang under AddressSanitizer
+# and UndefinedBehaviorSanitizer, with the libFuzzer targets run for a bounded time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 scripts/build.sh
 ctest --test-dir build --output-on-failure -j"$(nproc)"
+
+echo "dqjulia: sanitizer and fuzzing run (clang, ASan + UBSan)"
+CC=clang CXX=clang++ cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+  -DDQJ_SANITIZE=ON -DDQJ_FUZZ=ON >/dev/null
+cmake --build build-sanitize -j"$(nproc)"
+# Blender loads the library into its own (uninstrumented) process, where an ASan library cannot run.
+ctest --test-dir build-sanitize --output-on-failure -j"$(nproc)" -LE blender
