@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   build-essential cmake pkg-config clang libclang-rt-14-dev
   libglm-dev libtbb-dev nlohmann-json3-dev libcli11-dev libpng-dev libopenexr-dev
-  libgtest-dev libopenvdb-dev
+  libgtest-dev libopenvdb-dev libboost-iostreams-dev libfreetype-dev fonts-dejavu-core
 )
 
 missing=()

@@ -13,5 +13,7 @@ using Runner = std::function<int()>;
 Runner addRenderCommand(CLI::App& app);
 Runner addEvalCommand(CLI::App& app);
 Runner addInspectCommand(CLI::App& app);
+Runner addExploreCommand(CLI::App& app);
+Runner addSheetCommand(CLI::App& app);
 
 }  // namespace dqj::cli

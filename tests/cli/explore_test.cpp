@@ -1,0 +1,97 @@
+// dqjulia explore and sheet: reproducible constants with non-empty slices, labelled sheets.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "dqjulia/contact_sheet.hpp"
+#include "dqjulia/inspect.hpp"
+#include "dqjulia/params.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string readFile(const fs::path& path) {
+    std::ifstream file(path, std::ios::binary);
+    std::ostringstream text;
+    text << file.rdbuf();
+    return text.str();
+}
+
+int runCli(const std::string& arguments) {
+    const int status = std::system((std::string("'") + DQJ_CLI + "' " + arguments + " 2>/dev/null").c_str());
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+fs::path scratch(const std::string& name) {
+    const fs::path dir = fs::temp_directory_path() / ("dqjulia_explore_" + std::to_string(::getpid()) + "_" + name);
+    fs::remove_all(dir);
+    return dir;
+}
+
+TEST(Explore, SameSeedSameConstantsAndEveryTileIsNonEmpty) {
+    const fs::path first = scratch("first"), second = scratch("second");
+    ASSERT_EQ(runCli("explore -q --seed 11 --count 4 --columns 2 --tile-width 64 --tile-height 48 -o '" + first.string() + "'"), 0);
+    ASSERT_EQ(runCli("explore -q --seed 11 --count 4 --columns 2 --tile-width 64 --tile-height 48 -o '" + second.string() + "'"), 0);
+    for (int tile = 1; tile <= 4; ++tile) {
+        const std::string name = "tile_0" + std::to_string(tile);
+        const std::string json = readFile(first / (name + ".json"));
+        // The tile's parameter file is complete, the same for the same seed but for the folder
+        // its picture went to, and its slice is not empty.
+        const dqj::Params params = dqj::parseParams(json, name);
+        dqj::Params again = dqj::parseParams(readFile(second / (name + ".json")), name);
+        again.output.path = params.output.path;
+        EXPECT_EQ(dqj::toJson(params), dqj::toJson(again)) << name;
+        const dqj::InspectReport report = dqj::inspect(params, 16);
+        EXPECT_TRUE(report.emptyReason.empty()) << name << ": " << report.emptyReason;
+        EXPECT_GT(report.insideFraction, 0.0) << name;
+        EXPECT_EQ(dqj::readPng(first / (name + ".png")).width, 64);
+    }
+    EXPECT_FALSE(fs::exists(first / "tile_05.json"));
+    // A different seed gives different constants.
+    const fs::path other = scratch("other");
+    ASSERT_EQ(runCli("explore -q --seed 12 --count 1 --tile-width 32 --tile-height 24 -o '" + other.string() + "'"), 0);
+    EXPECT_NE(dqj::parseParams(readFile(other / "tile_01.json")).fractal.c.a, dqj::parseParams(readFile(first / "tile_01.json")).fractal.c.a);
+    // Two columns of 64 px plus padding; the sheet exists once and is refused the second time.
+    const dqj::Image sheet = dqj::readPng((first / "sheet.png").string());
+    EXPECT_EQ(sheet.width, 8 + 2 * (64 + 8));
+    EXPECT_EQ(runCli("explore -q --seed 11 --count 1 -o '" + first.string() + "'"), 2);
+    for (const fs::path& dir : {first, second, other}) fs::remove_all(dir);
+}
+
+TEST(ContactSheet, LaysOutTilesAndDrawsLabels) {
+    if (dqj::labelFontPath().empty()) GTEST_SKIP() << "no label font installed";
+    auto tile = [](float value) {
+        dqj::Image image;
+        image.width = 40;
+        image.height = 30;
+        image.rgba.assign(4 * 40 * 30, value);
+        return image;
+    };
+    dqj::SheetLayout layout;
+    layout.columns = 2;
+    const dqj::Image sheet = dqj::composeSheet({{tile(1.0f), "first"}, {tile(0.5f), "second\nline"}, {tile(0.25f), ""}}, layout);
+    const int labelHeight = layout.labelLines * (layout.fontPixels + layout.fontPixels / 3) + layout.padding / 2;
+    EXPECT_EQ(sheet.width, 8 + 2 * (40 + 8));
+    EXPECT_EQ(sheet.height, 8 + 2 * (30 + labelHeight + 8));
+    // Tiles land in their cells.
+    EXPECT_EQ(sheet.rgba[4 * (10 * sheet.width + 10)], 1.0f);
+    EXPECT_EQ(sheet.rgba[4 * (10 * sheet.width + 8 + 48 + 10)], 0.5f);
+    // The first label strip has text (bright pixels on the dark background); the third has none.
+    auto brightIn = [&](int x0, int y0) {
+        int bright = 0;
+        for (int y = y0; y < y0 + labelHeight; ++y)
+            for (int x = x0; x < x0 + 40; ++x) bright += sheet.rgba[4 * (std::size_t(y) * sheet.width + x)] > 0.3f;
+        return bright;
+    };
+    EXPECT_GT(brightIn(8, 8 + 30), 10);
+    EXPECT_EQ(brightIn(8, 8 + 30 + labelHeight + 8 + 30), 0);
+    EXPECT_THROW(dqj::composeSheet({}, layout), std::runtime_error);
+}
+
+}  // namespace
