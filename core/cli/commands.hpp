@@ -13,6 +13,9 @@ using Runner = std::function<int()>;
 Runner addRenderCommand(CLI::App& app);
 Runner addEvalCommand(CLI::App& app);
 Runner addInspectCommand(CLI::App& app);
+Runner addBakeCommand(CLI::App& app);
+Runner addMeshCommand(CLI::App& app);
+Runner addPovrayCommand(CLI::App& app);
 Runner addExploreCommand(CLI::App& app);
 Runner addSheetCommand(CLI::App& app);
 

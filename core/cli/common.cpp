@@ -165,7 +165,8 @@ bool ProgressBar::update(double fraction) {
     std::string eta = fraction > 0.02 && fraction < 1.0 ? " ETA " + formatDuration(elapsed / fraction * (1.0 - fraction)) : "";
     char percent[16];
     std::snprintf(percent, sizeof percent, "%3d%%", int(fraction * 100.0));
-    std::cerr << "\r" << label_ << " [" << bar << "] " << percent << "  " << formatDuration(elapsed) << eta << "\x1b[K"
+    std::cerr << "\r" << label_ << " [" << bar << "] " << percent << "  " << formatDuration(elapsed) << eta
+              << (status_.empty() ? "" : "  ") << status_ << "\x1b[K"
               << std::flush;
     drawn_ = true;
     return true;

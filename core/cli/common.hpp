@@ -49,10 +49,13 @@ public:
     ~ProgressBar();
     ProgressCallback callback();
     void finish();
+    /// Text drawn after the bar from the next update on (e.g. "sampling, 1.2M of 16.8M voxels").
+    void setStatus(std::string status) { status_ = std::move(status); }
 
 private:
     bool update(double fraction);
     std::string label_;
+    std::string status_;
     bool enabled_;
     double startSeconds_;
     double lastDrawSeconds_ = -1.0;

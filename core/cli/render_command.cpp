@@ -8,6 +8,7 @@
 #include "dqjulia/image.hpp"
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/render.hpp"
+#include "dqjulia/voxel_render.hpp"
 
 namespace dqj::cli {
 namespace {
@@ -21,6 +22,7 @@ struct RenderOptions {
     std::string normals, coloring;
     std::vector<double> cameraPosition, cameraTarget;
     std::string saveParams;
+    std::string voxels;
     bool quiet = false;
     bool stats = false;
     bool force = false;
@@ -72,7 +74,8 @@ int runRender(const RenderOptions& options) {
     if (!provenEmpty.empty()) std::cerr << "dqjulia render: warning: " << provenEmpty << "\n";
 
     ProgressBar progress("rendering", options.quiet);
-    const RenderResult result = render(params, progress.callback());
+    const RenderResult result = options.voxels.empty() ? render(params, progress.callback())
+                                                       : renderVoxels(params, options.voxels, progress.callback());
     progress.finish();
     writeImage(result.image, params.output.path, formatFor(params.output));
 
@@ -119,6 +122,9 @@ Runner addRenderCommand(CLI::App& app) {
     command->add_option("--camera-position", options->cameraPosition, "Camera position x y z")->expected(3);
     command->add_option("--camera-target", options->cameraTarget, "Camera target x y z")->expected(3);
     command->add_option("--save-params", options->saveParams, "Also write the complete parameter file used");
+    command->add_option("--voxels", options->voxels,
+                        "Draw the voxels of a baked VDB (its density grid) as cubes instead of tracing the fractal")
+        ->check(CLI::ExistingFile);
     command->add_flag("-f,--force", options->force, "Overwrite existing output files");
     command->add_flag("-q,--quiet", options->quiet, "No progress bar or summary");
     command->add_flag("--stats", options->stats, "Print ray and step counts to stdout");

@@ -13,6 +13,7 @@ struct SheetOptions {
     std::vector<std::string> labels;
     std::string output;
     int columns = 3;
+    int labelLines = 3;
     bool force = false;
 };
 
@@ -26,6 +27,7 @@ int runSheet(const SheetOptions& options) {
         tiles.push_back({readPng(options.images[index]), options.labels.empty() ? options.images[index] : options.labels[index]});
     SheetLayout layout;
     layout.columns = options.columns;
+    layout.labelLines = options.labelLines;
     writeImage(composeSheet(tiles, layout), options.output, ImageFormat::Png8);
     return kSuccess;
 }
@@ -39,6 +41,7 @@ Runner addSheetCommand(CLI::App& app) {
     command->add_option("-l,--label", options->labels, "Its label (repeat, one per --tile; \\n breaks lines)");
     command->add_option("-o,--output", options->output, "The sheet (.png)")->required();
     command->add_option("--columns", options->columns, "Tiles per row")->check(CLI::Range(1, 20));
+    command->add_option("--label-lines", options->labelLines, "Text lines reserved under each tile")->check(CLI::Range(0, 20));
     command->add_flag("-f,--force", options->force, "Overwrite an existing sheet");
     return [options] { return reportErrors("sheet", [&] { return runSheet(*options); }); };
 }

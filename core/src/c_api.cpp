@@ -3,6 +3,7 @@
 // gives DQJ_ERROR_INVALID_HANDLE instead of a crash.
 #include "dqjulia/dqjulia.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <mutex>
@@ -10,8 +11,10 @@
 #include <string>
 #include <unordered_set>
 
+#include "dqjulia/bake.hpp"
 #include "dqjulia/image.hpp"
 #include "dqjulia/inspect.hpp"
+#include "dqjulia/mesh.hpp"
 #include "dqjulia/params.hpp"
 #include "dqjulia/render.hpp"
 
@@ -19,6 +22,10 @@ struct dqj_context_t {
     dqj::Params params;
     std::string error;
     std::string warning;
+    double frame = 1.0;             // where keyframed parameters are taken (dqj_context_set_frame)
+    std::uint64_t memoryLimit = 0;  // 0 = dqj::defaultMemoryLimit()
+    dqj::Mesh mesh;                 // from the last dqj_mesh_compute
+    dqj::BakeStats bakeStats;       // of the last bake or mesh
 };
 
 namespace {
@@ -45,6 +52,9 @@ dqj_status guarded(dqj_context context, Body&& body) {
     context->warning.clear();
     try {
         return body(*context);
+    } catch (const dqj::MemoryLimitError& error) {
+        context->error = error.what();
+        return DQJ_ERROR_OUT_OF_MEMORY;
     } catch (const dqj::ParamError& error) {
         context->error = error.what();
         return DQJ_ERROR_PARAMETERS;
@@ -105,6 +115,41 @@ void fillSample(const dqj::Escape& escape, dqj_sample& sample) {
     sample.ra = escape.ra;
     sample.rb = escape.rb;
     sample.de = escape.de;
+}
+
+/// The context's parameters at its frame (keyframes applied), validated.
+dqj::Params paramsNow(const dqj_context_t& context) {
+    if (context.params.animation.empty()) return context.params;
+    dqj::Params params = dqj::atFrame(context.params, context.frame);
+    dqj::validate(params);
+    return params;
+}
+
+/// Runs a bake step that writes a file: I/O failures (std::runtime_error that is neither a
+/// parameter problem nor a cancel) become DQJ_ERROR_IO.
+template <typename Work>
+dqj_status withFileErrors(dqj_context_t& context, Work&& work) {
+    try {
+        work();
+    } catch (const dqj::ParamError&) {
+        throw;
+    } catch (const dqj::Cancelled&) {
+        throw;
+    } catch (const std::runtime_error& error) {
+        context.error = error.what();
+        return DQJ_ERROR_IO;
+    }
+    return DQJ_OK;
+}
+
+/// After a bake or mesh: if there is no surface, say why (like noteEmptyRender).
+void noteEmptyBake(dqj_context_t& context, const dqj::Params& params, bool empty) {
+    if (!empty) return;
+    const dqj::InspectReport report = dqj::inspect(params);
+    context.warning = "the bake found no surface: " +
+                      (report.emptyReason.empty() ? std::string("nothing within the bounds is in the set at this resolution; "
+                                                                "try more iterations or a higher resolution")
+                                                  : report.emptyReason);
 }
 
 /// After a render: if nothing was hit, say why on the context (a silent empty picture is a bug).
@@ -277,7 +322,7 @@ dqj_status dqj_render_rgba8(dqj_context context, uint8_t* pixels, uint32_t width
         if (width == 0 || height == 0 || width > 16384 || height > 16384)
             return invalidArgument(self, "width and height must be from 1 to 16384");
         if (stride < size_t(width) * 4) return invalidArgument(self, "stride is smaller than 4 * width");
-        dqj::Params params = self.params;
+        dqj::Params params = paramsNow(self);
         params.render.width = int(width);
         params.render.height = int(height);
         const dqj::RenderResult result = dqj::render(params, wrapProgress(progress, userData));
@@ -297,7 +342,7 @@ dqj_status dqj_render_rgba8(dqj_context context, uint8_t* pixels, uint32_t width
 dqj_status dqj_render_to_file(dqj_context context, const char* path, dqj_progress_fn progress, void* userData) {
     return guarded(context, [&](dqj_context_t& self) {
         if (!path) return invalidArgument(self, "path is NULL");
-        dqj::Params params = self.params;
+        dqj::Params params = paramsNow(self);
         params.output.path = path;
         dqj::validate(params);
         const dqj::RenderResult result = dqj::render(params, wrapProgress(progress, userData));
@@ -315,6 +360,111 @@ dqj_status dqj_render_to_file(dqj_context context, const char* path, dqj_progres
 dqj_status dqj_inspect_json(dqj_context context, char* buffer, size_t capacity, size_t* outSize) {
     return guarded(context, [&](dqj_context_t& self) {
         return copyText(self, dqj::reportJson(dqj::inspect(self.params)), buffer, capacity, outSize);
+    });
+}
+
+dqj_status dqj_context_set_bake_resolution(dqj_context context, int resolution) {
+    return guarded(context, [&](dqj_context_t& self) {
+        return changeParams(self, [&](dqj::Params& params) { params.bake.resolution = resolution; });
+    });
+}
+
+dqj_status dqj_context_set_frame(dqj_context context, double frame) {
+    return guarded(context, [&](dqj_context_t& self) {
+        if (!std::isfinite(frame) || std::abs(frame) > 1e6) return invalidArgument(self, "frame must be a finite number within +-1e6");
+        self.frame = frame;
+        return DQJ_OK;
+    });
+}
+
+dqj_status dqj_context_set_memory_limit(dqj_context context, uint64_t bytes) {
+    return guarded(context, [&](dqj_context_t& self) {
+        self.memoryLimit = bytes;
+        return DQJ_OK;
+    });
+}
+
+dqj_status dqj_bake_vdb(dqj_context context, const char* path, dqj_progress_fn progress, void* userData) {
+    return guarded(context, [&](dqj_context_t& self) {
+        if (!path) return invalidArgument(self, "path is NULL");
+        const dqj::Params params = paramsNow(self);
+        dqj::BakeOptions options;
+        options.memoryLimit = self.memoryLimit;
+        dqj::BakeStats stats;
+        const dqj_status status =
+            withFileErrors(self, [&] { stats = dqj::bakeVdb(params, path, options, wrapProgress(progress, userData)); });
+        if (status != DQJ_OK) return status;
+        self.bakeStats = stats;
+        noteEmptyBake(self, params, stats.activeVoxels == 0);
+        return DQJ_OK;
+    });
+}
+
+dqj_status dqj_mesh_compute(dqj_context context, dqj_progress_fn progress, void* userData) {
+    return guarded(context, [&](dqj_context_t& self) {
+        const dqj::Params params = paramsNow(self);
+        dqj::BakeOptions options;
+        options.memoryLimit = self.memoryLimit;
+        dqj::BakeStats stats;
+        dqj::Mesh mesh = dqj::bakeMesh(params, options, wrapProgress(progress, userData), &stats);
+        if (mesh.positions.size() > UINT32_MAX) return invalidArgument(self, "the mesh has more than 2^32 vertices");
+        self.mesh = std::move(mesh);
+        self.bakeStats = stats;
+        noteEmptyBake(self, params, self.mesh.positions.empty());
+        return DQJ_OK;
+    });
+}
+
+dqj_status dqj_mesh_get_sizes(dqj_context context, size_t* outVertexCount, size_t* outTriangleCount) {
+    return guarded(context, [&](dqj_context_t& self) {
+        if (outVertexCount) *outVertexCount = self.mesh.positions.size();
+        if (outTriangleCount) *outTriangleCount = self.mesh.triangleCount();
+        return DQJ_OK;
+    });
+}
+
+dqj_status dqj_mesh_copy(dqj_context context, float* positions, float* normals, float* colors, size_t vertexCapacity,
+                         uint32_t* triangles, size_t triangleCapacity) {
+    return guarded(context, [&](dqj_context_t& self) {
+        const dqj::Mesh& mesh = self.mesh;
+        const size_t vertices = mesh.positions.size();
+        if (vertices != 0 && (!positions || !triangles)) return invalidArgument(self, "positions or triangles is NULL");
+        if (vertexCapacity < vertices || triangleCapacity < mesh.triangleCount())
+            return invalidArgument(self, "buffers too small: the mesh has " + std::to_string(vertices) + " vertices and " +
+                                             std::to_string(mesh.triangleCount()) + " triangles; capacities are " +
+                                             std::to_string(vertexCapacity) + " and " + std::to_string(triangleCapacity));
+        if (colors && mesh.colors.size() != vertices)
+            return invalidArgument(self, "the mesh has no colours (bake.mesh_colors is false); pass colors = NULL");
+        for (size_t index = 0; index < vertices; ++index) {
+            for (int axis = 0; axis < 3; ++axis) {
+                positions[3 * index + axis] = mesh.positions[index][axis];
+                if (normals) normals[3 * index + axis] = mesh.normals[index][axis];
+                if (colors) colors[3 * index + axis] = mesh.colors[index][axis];
+            }
+        }
+        const std::vector<std::uint32_t> indices = mesh.triangulated();
+        std::copy(indices.begin(), indices.end(), triangles);
+        return DQJ_OK;
+    });
+}
+
+dqj_status dqj_mesh_write(dqj_context context, const char* path) {
+    return guarded(context, [&](dqj_context_t& self) {
+        if (!path) return invalidArgument(self, "path is NULL");
+        if (self.mesh.positions.empty()) return invalidArgument(self, "the context has no mesh: call dqj_mesh_compute first");
+        return withFileErrors(self, [&] { dqj::writeMesh(self.mesh, path); });
+    });
+}
+
+dqj_status dqj_bake_get_stats(dqj_context context, dqj_bake_stats* outStats) {
+    return guarded(context, [&](dqj_context_t& self) {
+        if (!outStats) return invalidArgument(self, "out_stats is NULL");
+        outStats->voxels_evaluated = self.bakeStats.evaluated;
+        outStats->voxels_dense = self.bakeStats.dense;
+        outStats->active_voxels = self.bakeStats.activeVoxels;
+        outStats->estimated_bytes = self.bakeStats.estimatedBytes;
+        outStats->seconds = self.bakeStats.seconds;
+        return DQJ_OK;
     });
 }
 

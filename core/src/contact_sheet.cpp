@@ -115,19 +115,24 @@ Image composeSheet(const std::vector<SheetTile>& tiles, const SheetLayout& layou
         throw std::runtime_error("no font for the labels: install fonts-dejavu-core or set DQJ_FONT to a .ttf file");
     Font font(fontPath, layout.fontPixels);
 
-    int cellWidth = 0, cellHeight = 0;
-    for (const SheetTile& tile : tiles) {
-        cellWidth = std::max(cellWidth, tile.image.width);
-        cellHeight = std::max(cellHeight, tile.image.height);
+    // Columns share the widest tile's width; each row is as tall as its tallest tile.
+    const int columns = std::max(1, std::min<int>(layout.columns, static_cast<int>(tiles.size())));
+    const int rows = (static_cast<int>(tiles.size()) + columns - 1) / columns;
+    int cellWidth = 0;
+    std::vector<int> rowHeights(rows, 0);
+    for (std::size_t index = 0; index < tiles.size(); ++index) {
+        cellWidth = std::max(cellWidth, tiles[index].image.width);
+        int& rowHeight = rowHeights[index / columns];
+        rowHeight = std::max(rowHeight, tiles[index].image.height);
     }
     const int lineHeight = layout.fontPixels + layout.fontPixels / 3;
     const int labelHeight = layout.labelLines * lineHeight + layout.padding / 2;
-    const int columns = std::max(1, std::min<int>(layout.columns, static_cast<int>(tiles.size())));
-    const int rows = (static_cast<int>(tiles.size()) + columns - 1) / columns;
+    std::vector<int> rowTops(rows, layout.padding);
+    for (int row = 1; row < rows; ++row) rowTops[row] = rowTops[row - 1] + rowHeights[row - 1] + labelHeight + layout.padding;
 
     Image sheet;
     sheet.width = layout.padding + columns * (cellWidth + layout.padding);
-    sheet.height = layout.padding + rows * (cellHeight + labelHeight + layout.padding);
+    sheet.height = rowTops.back() + rowHeights.back() + labelHeight + layout.padding;
     sheet.rgba.resize(4 * static_cast<std::size_t>(sheet.width) * sheet.height);
     for (std::size_t pixel = 0; pixel < sheet.rgba.size() / 4; ++pixel) {
         for (int channel = 0; channel < 3; ++channel) sheet.rgba[4 * pixel + channel] = static_cast<float>(layout.background[channel]);
@@ -139,7 +144,8 @@ Image composeSheet(const std::vector<SheetTile>& tiles, const SheetLayout& layou
         const int column = static_cast<int>(index) % columns;
         const int row = static_cast<int>(index) / columns;
         const int left = layout.padding + column * (cellWidth + layout.padding);
-        const int top = layout.padding + row * (cellHeight + labelHeight + layout.padding);
+        const int top = rowTops[row];
+        const int cellHeight = rowHeights[row];
         const int x0 = left + (cellWidth - image.width) / 2;
         const int y0 = top + (cellHeight - image.height) / 2;
         for (int y = 0; y < image.height; ++y)

@@ -3,6 +3,7 @@
 #include "dqjulia/params.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -179,6 +180,11 @@ constexpr std::array<std::pair<std::string_view, Coloring>, 3> kColorings{
     {{"solid", Coloring::Solid}, {"iterations", Coloring::Iterations}, {"trap", Coloring::Trap}}};
 constexpr std::array<std::pair<std::string_view, NormalMethod>, 3> kNormalMethods{
     {{"auto", NormalMethod::Auto}, {"central", NormalMethod::CentralDifferences}, {"analytic", NormalMethod::Analytic}}};
+constexpr std::array<std::pair<std::string_view, BakeGrid>, 5> kBakeGrids{
+    {{"surface", BakeGrid::Surface}, {"density", BakeGrid::Density}, {"color", BakeGrid::Color},
+     {"trap", BakeGrid::Trap}, {"iterations", BakeGrid::Iterations}}};
+constexpr std::array<std::pair<std::string_view, Interpolation>, 2> kInterpolations{
+    {{"linear", Interpolation::Linear}, {"smooth", Interpolation::Smooth}}};
 constexpr std::array<std::pair<std::string_view, ImageFormat>, 3> kFormats{
     {{"png8", ImageFormat::Png8}, {"png16", ImageFormat::Png16}, {"exr", ImageFormat::Exr}}};
 
@@ -327,6 +333,113 @@ void readRender(ObjectReader reader, RenderSettings& render) {
     reader.finish();
 }
 
+void readBake(ObjectReader reader, BakeSettings& bake) {
+    reader.readInteger("resolution", bake.resolution, 8, 16384);
+    if (const Json* value = reader.find("bounds")) {
+        if (value->is_string() && value->get<std::string>() == "auto") {
+            bake.bounds.reset();
+        } else {
+            ObjectReader box(*value, reader.keyPath("bounds"), reader.source());
+            Box result;
+            const Json* min = box.find("min");
+            const Json* max = box.find("max");
+            if (!min || !max) box.fail(box.path(), "must be \"auto\" or {\"min\": [x, y, z], \"max\": [x, y, z]}");
+            result.min = box.vec3(*min, box.keyPath("min"), -1e6, 1e6);
+            result.max = box.vec3(*max, box.keyPath("max"), -1e6, 1e6);
+            box.finish();
+            bake.bounds = result;
+        }
+    }
+    reader.readNumber("band_width", bake.bandWidth, 1.0, 32.0);
+    if (const Json* value = reader.find("grids")) {
+        const std::string key = reader.keyPath("grids");
+        if (!value->is_array() || value->empty())
+            reader.fail(key, "must be a non-empty array of grid names (surface, density, color, trap, iterations), got " +
+                                 describe(*value));
+        bake.grids.clear();
+        for (std::size_t index = 0; index < value->size(); ++index) {
+            const BakeGrid grid = parseChoice(reader, (*value)[index], key + "[" + std::to_string(index) + "]", kBakeGrids);
+            if (std::find(bake.grids.begin(), bake.grids.end(), grid) != bake.grids.end())
+                reader.fail(key, "names \"" + std::string(nameOf(grid, kBakeGrids)) + "\" twice");
+            bake.grids.push_back(grid);
+        }
+    }
+    reader.readNumber("adaptivity", bake.adaptivity, 0.0, 1.0);
+    reader.readBool("mesh_colors", bake.meshColors);
+    reader.finish();
+}
+
+/// "slice.rotations[3].degrees" -> 3; std::nullopt for anything else.
+std::optional<int> rotationTrackIndex(const std::string& key) {
+    const std::string prefix = "slice.rotations[", suffix = "].degrees";
+    if (key.size() <= prefix.size() + suffix.size() || key.rfind(prefix, 0) != 0 ||
+        key.compare(key.size() - suffix.size(), suffix.size(), suffix) != 0)
+        return std::nullopt;
+    const std::string digits = key.substr(prefix.size(), key.size() - prefix.size() - suffix.size());
+    if (digits.empty() || digits.size() > 4 || !std::all_of(digits.begin(), digits.end(), [](unsigned char ch) { return std::isdigit(ch); }))
+        return std::nullopt;
+    return std::stoi(digits);
+}
+
+/// The "animation" object: {"fractal.c": [{"frame": 1, "value": [...], "interpolation": "smooth"}, ...], ...}.
+void readAnimation(const Json& node, const std::string& source, std::vector<Track>& tracks) {
+    ObjectReader reader(node, "animation", source);  // checks that it is an object
+    tracks.clear();
+    for (const auto& item : node.items()) {
+        const std::string key = reader.keyPath(item.key());
+        Track track;
+        double low = 0.0, high = 0.0;
+        if (item.key() == "fractal.c") {
+            track.target = AnimatedValue::Constant;
+            low = -100.0, high = 100.0;
+        } else if (item.key() == "fractal.iterations") {
+            track.target = AnimatedValue::Iterations;
+            low = 1.0, high = 100000.0;
+        } else if (item.key() == "fractal.bailout") {
+            track.target = AnimatedValue::Bailout;
+            low = 1.0, high = 1e150;
+        } else if (const auto rotation = rotationTrackIndex(item.key())) {
+            track.target = AnimatedValue::RotationDegrees;
+            track.rotation = *rotation;
+            low = -36000.0, high = 36000.0;
+        } else {
+            reader.fail(key, "cannot be animated (animatable: fractal.c, fractal.iterations, fractal.bailout, "
+                             "slice.rotations[i].degrees)");
+        }
+        const Json& keys = item.value();
+        if (!keys.is_array() || keys.empty())
+            reader.fail(key, "must be a non-empty array of keys {\"frame\": 1, \"value\": ..., \"interpolation\": \"linear\"}, got " +
+                                 describe(keys));
+        for (std::size_t index = 0; index < keys.size(); ++index) {
+            ObjectReader keyReader(keys[index], key + "[" + std::to_string(index) + "]", source);
+            Keyframe keyframe;
+            const Json* frame = keyReader.find("frame");
+            const Json* value = keyReader.find("value");
+            if (!frame || !value) keyReader.fail(keyReader.path(), "needs \"frame\" and \"value\"");
+            keyframe.frame = keyReader.number(*frame, keyReader.keyPath("frame"), -1e6, 1e6);
+            if (track.target == AnimatedValue::Constant) {
+                const auto c = keyReader.array<8>(*value, keyReader.keyPath("value"), low, high);
+                keyframe.value.assign(c.begin(), c.end());
+            } else {
+                const double number = keyReader.number(*value, keyReader.keyPath("value"), low, high);
+                if (track.target == AnimatedValue::Iterations && std::nearbyint(number) != number)
+                    keyReader.fail(keyReader.keyPath("value"), "must be a whole number, got " + formatNumber(number));
+                if (track.target == AnimatedValue::Bailout && number == low)
+                    keyReader.fail(keyReader.keyPath("value"), "must be greater than 1");
+                keyframe.value = {number};
+            }
+            if (const Json* interpolation = keyReader.find("interpolation"))
+                keyframe.interpolation = parseChoice(keyReader, *interpolation, keyReader.keyPath("interpolation"), kInterpolations);
+            keyReader.finish();
+            if (!track.keys.empty() && !(keyframe.frame > track.keys.back().frame))
+                keyReader.fail(keyReader.keyPath("frame"), "frames must increase from key to key: " + formatNumber(keyframe.frame) +
+                                                               " follows " + formatNumber(track.keys.back().frame));
+            track.keys.push_back(keyframe);
+        }
+        tracks.push_back(track);
+    }
+}
+
 void readOutput(ObjectReader reader, OutputSettings& output) {
     reader.readString("path", output.path);
     if (const Json* value = reader.find("format")) output.format = parseChoice(reader, *value, reader.keyPath("format"), kFormats);
@@ -421,6 +534,8 @@ Params parseParams(const std::string& jsonText, const std::string& source, Valid
     if (const Json* value = root.find("material")) readMaterial(ObjectReader(*value, "material", source), params.material);
     if (const Json* value = root.find("render")) readRender(ObjectReader(*value, "render", source), params.render);
     if (const Json* value = root.find("output")) readOutput(ObjectReader(*value, "output", source), params.output);
+    if (const Json* value = root.find("bake")) readBake(ObjectReader(*value, "bake", source), params.bake);
+    if (const Json* value = root.find("animation")) readAnimation(*value, source, params.animation);
     root.finish();
     if (validation == Validation::TypesOnly) return params;
     try {
@@ -504,6 +619,36 @@ void validate(const Params& params) {
         if (extension != ".png" && extension != ".exr")
             fail("output.path", "\"" + params.output.path + "\" must end in .png or .exr (or set output.format to png8, png16 or exr)");
     }
+
+    const BakeSettings& bake = params.bake;
+    if (bake.resolution < 8 || bake.resolution > 16384) fail("bake.resolution", "must be a whole number from 8 to 16384");
+    if (bake.bounds) {
+        for (int axis = 0; axis < 3; ++axis)
+            if (!(bake.bounds->min[axis] < bake.bounds->max[axis]) || !std::isfinite(bake.bounds->min[axis]) ||
+                !std::isfinite(bake.bounds->max[axis]))
+                fail("bake.bounds", "min must be below max on every axis (x, y, z), with finite numbers");
+    }
+    if (!(bake.bandWidth >= 1.0 && bake.bandWidth <= 32.0)) fail("bake.band_width", "must be from 1 to 32 voxels");
+    if (bake.grids.empty()) fail("bake.grids", "must name at least one grid");
+    if (!(bake.adaptivity >= 0.0 && bake.adaptivity <= 1.0)) fail("bake.adaptivity", "must be from 0 to 1");
+
+    // Keyframes: a rotation track needs its rotation, and the parameters at every key must pass
+    // the rules above (the frames between keys are checked when they are baked).
+    for (const Track& track : params.animation) {
+        if (track.target == AnimatedValue::RotationDegrees && track.rotation >= int(params.slice.rotations.size()))
+            fail("animation." + trackKey(track), "animates rotation " + std::to_string(track.rotation) + " but slice.rotations has " +
+                                                     std::to_string(params.slice.rotations.size()) + " (they count from 0)");
+        for (const Keyframe& key : track.keys) {
+            Params still = atFrame(params, key.frame);
+            still.animation.clear();
+            try {
+                validate(still);
+            } catch (const ParamError& error) {
+                throw ParamError(error.key(), "animation: at frame " + formatNumber(key.frame) + " (a key of " +
+                                                  trackKey(track) + "): " + error.what());
+            }
+        }
+    }
 }
 
 std::string toJson(const Params& params) {
@@ -570,6 +715,30 @@ std::string toJson(const Params& params) {
     OrderedJson output{{"path", params.output.path}};
     if (params.output.format) output["format"] = imageFormatName(*params.output.format);
     document["output"] = output;
+    const BakeSettings& bake = params.bake;
+    OrderedJson grids = OrderedJson::array();
+    for (const BakeGrid grid : bake.grids) grids.push_back(bakeGridName(grid));
+    OrderedJson bakeJson{{"resolution", bake.resolution}};
+    if (bake.bounds) {
+        bakeJson["bounds"] = {{"min", vec3Json(bake.bounds->min)}, {"max", vec3Json(bake.bounds->max)}};
+    } else {
+        bakeJson["bounds"] = "auto";
+    }
+    bakeJson["band_width"] = bake.bandWidth;
+    bakeJson["grids"] = grids;
+    bakeJson["adaptivity"] = bake.adaptivity;
+    bakeJson["mesh_colors"] = bake.meshColors;
+    document["bake"] = bakeJson;
+    OrderedJson animation = OrderedJson::object();
+    for (const Track& track : params.animation) {
+        OrderedJson keys = OrderedJson::array();
+        for (const Keyframe& key : track.keys) {
+            OrderedJson value = track.target == AnimatedValue::Constant ? OrderedJson(key.value) : OrderedJson(key.value.at(0));
+            keys.push_back({{"frame", key.frame}, {"value", value}, {"interpolation", nameOf(key.interpolation, kInterpolations)}});
+        }
+        animation[trackKey(track)] = keys;
+    }
+    document["animation"] = animation;
     return compactNumberArrays(document.dump(2)) + "\n";
 }
 
@@ -595,6 +764,88 @@ ImageFormat formatFor(const OutputSettings& output) {
     if (dot != std::string::npos) extension = output.path.substr(dot + 1);
     std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char ch) { return std::tolower(ch); });
     return extension == "exr" ? ImageFormat::Exr : ImageFormat::Png8;
+}
+
+namespace {
+
+/// The slope at key `index` of one component for smooth interpolation: 0 at the first and last
+/// key and where the values turn (a local extremum), else the weighted harmonic mean of the two
+/// neighbouring secant slopes (Fritsch-Butland), which keeps the cubic monotone between keys.
+double smoothSlope(const std::vector<Keyframe>& keys, std::size_t index, std::size_t component) {
+    if (index == 0 || index + 1 >= keys.size()) return 0.0;
+    const double h0 = keys[index].frame - keys[index - 1].frame;
+    const double h1 = keys[index + 1].frame - keys[index].frame;
+    const double d0 = (keys[index].value[component] - keys[index - 1].value[component]) / h0;
+    const double d1 = (keys[index + 1].value[component] - keys[index].value[component]) / h1;
+    if (d0 * d1 <= 0.0) return 0.0;
+    const double w0 = 2.0 * h1 + h0, w1 = h1 + 2.0 * h0;
+    return (w0 + w1) / (w0 / d0 + w1 / d1);
+}
+
+/// The track's value at `frame`, one number per component.
+std::vector<double> trackValue(const Track& track, double frame) {
+    const std::vector<Keyframe>& keys = track.keys;
+    if (frame <= keys.front().frame) return keys.front().value;
+    if (frame >= keys.back().frame) return keys.back().value;
+    std::size_t index = 0;
+    while (!(frame < keys[index + 1].frame)) ++index;
+    const Keyframe& from = keys[index];
+    const Keyframe& to = keys[index + 1];
+    const double span = to.frame - from.frame;
+    const double t = (frame - from.frame) / span;
+    std::vector<double> value(from.value.size());
+    for (std::size_t component = 0; component < value.size(); ++component) {
+        const double v0 = from.value[component], v1 = to.value[component];
+        if (from.interpolation == Interpolation::Linear) {
+            value[component] = v0 + t * (v1 - v0);
+            continue;
+        }
+        // Cubic Hermite between the keys with the slopes above.
+        const double m0 = smoothSlope(keys, index, component) * span;
+        const double m1 = smoothSlope(keys, index + 1, component) * span;
+        const double t2 = t * t, t3 = t2 * t;
+        value[component] = (2 * t3 - 3 * t2 + 1) * v0 + (t3 - 2 * t2 + t) * m0 + (-2 * t3 + 3 * t2) * v1 + (t3 - t2) * m1;
+    }
+    return value;
+}
+
+}  // namespace
+
+Params atFrame(const Params& params, double frame) {
+    Params result = params;
+    for (const Track& track : params.animation) {
+        const std::vector<double> value = trackValue(track, frame);
+        switch (track.target) {
+            case AnimatedValue::Constant: {
+                Vec8 c;
+                std::copy(value.begin(), value.end(), c.begin());
+                result.fractal.c = toDualQuat(c);
+                break;
+            }
+            case AnimatedValue::Iterations: result.fractal.iterations = std::max(1, int(std::lround(value[0]))); break;
+            case AnimatedValue::Bailout: result.fractal.bailout = value[0]; break;
+            case AnimatedValue::RotationDegrees:
+                if (track.rotation < int(result.slice.rotations.size())) result.slice.rotations[track.rotation].degrees = value[0];
+                break;
+        }
+    }
+    return result;
+}
+
+std::string trackKey(const Track& track) {
+    switch (track.target) {
+        case AnimatedValue::Constant: return "fractal.c";
+        case AnimatedValue::Iterations: return "fractal.iterations";
+        case AnimatedValue::Bailout: return "fractal.bailout";
+        case AnimatedValue::RotationDegrees: return "slice.rotations[" + std::to_string(track.rotation) + "].degrees";
+    }
+    return "unknown";
+}
+
+std::string_view bakeGridName(BakeGrid grid) { return nameOf(grid, kBakeGrids); }
+
+bool hasGrid(const BakeSettings& bake, BakeGrid grid) {
+    return std::find(bake.grids.begin(), bake.grids.end(), grid) != bake.grids.end();
 }
 
 }  // namespace dqj

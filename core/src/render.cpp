@@ -2,7 +2,14 @@
 //
 // All geometry is in slice (3-D) coordinates. The distance estimate is in 8-D units; a 3-D
 // step of length s moves at most stretch.max * s in 8-D, so DE / stretch.max is a safe 3-D step.
+//
+// Each camera ray is a RayJob: a state machine that asks for the points it needs evaluated
+// (marching, bisection, normal and occlusion probes, shadow marches) and consumes their
+// escapes. The packet engine runs the rays of a tile as a wavefront: each round the queries of
+// every unfinished ray go through the SIMD batch kernel together and finished rays retire. The
+// scalar engine answers each query with evaluate(), the reference; both run the same logic.
 #include "dqjulia/render.hpp"
+#include "dqjulia/batch.hpp"
 #include "dqjulia/inspect.hpp"
 
 #include <algorithm>
@@ -28,6 +35,7 @@ constexpr int kOcclusionSamples = 5;
 constexpr int kShadowSteps = 64;     // soft shadows are a look, not a measurement: cap their cost
 constexpr int kBisectionSteps = 8;   // refines a step that landed inside to 1/256 of the step
 constexpr double kFootprintFloor = 1e-7;
+constexpr int kRaysPerPass = 1024;     // rays traced together: whole pixels of a tile
 
 /// Where a ray meets a sphere: [near, far] along the ray, or nothing.
 struct Interval {
@@ -47,11 +55,34 @@ Interval intersectSphere(const glm::dvec3& origin, const glm::dvec3& direction, 
     return {true, std::max(0.0, -b - root), -b + root};
 }
 
+/// What the renderer reads of an evaluation: Escape without the exit state, small enough to pass
+/// around by the million.
+struct Probe {
+    int n = 0;
+    double r = 0.0;
+    double ra = 0.0;
+    double rb = 0.0;
+    double de = 0.0;
+    double trap = 0.0;
+
+    static Probe of(const Escape& escape) { return {escape.n, escape.r, escape.ra, escape.rb, escape.de, escape.trap}; }
+    Escape escape() const {
+        Escape escape;
+        escape.n = n;
+        escape.r = r;
+        escape.ra = ra;
+        escape.rb = rb;
+        escape.de = de;
+        escape.trap = trap;
+        return escape;
+    }
+};
+
 /// Result of marching one ray.
 struct Trace {
     bool hit = false;
     double t = kInfinity;
-    Escape escape;          ///< at the hit point (outside the finite-N set when refined)
+    Probe escape;           ///< at the hit point (outside the finite-N set when refined)
     bool cutFace = false;   ///< started inside the set on the bounding sphere (a clipped set)
     int steps = 0;
 };
@@ -87,10 +118,6 @@ public:
         // Occlusion probes reach 5 * 2% of the bounds' radius: about the size of the bulbs of a
         // typical set, so creases darken while flat parts stay lit.
         occlusionDelta_ = 0.02 * bounds_.radius;
-        // Trap colouring: the orbit's closest approach to 0 ranges over [0, r_K(c_a)] and is
-        // mostly below half of it on the surface; scaling by r_K/2 spreads the default set's
-        // values over the whole palette.
-        trapScale_ = 0.65 * containmentRadius(fractal_.c.a);
     }
 
     const CameraFrame& camera() const { return camera_; }
@@ -102,186 +129,15 @@ public:
     Escape evaluateAt(const glm::dvec3& p) const { return evaluate(fractal_, slice_.map(p)); }
 
     /// The DE as a 3-D distance; 0 inside, +inf for a zero derivative.
-    double distance3(const Escape& escape) const { return escape.n == 0 ? 0.0 : escape.de / stretch_; }
-
-    Trace march(const glm::dvec3& origin, const glm::dvec3& direction) const {
-        Trace trace;
-        const Interval span = intersectSphere(origin, direction, bounds_);
-        if (!span.valid || empty_) return trace;
-        double t = span.near;
-        double previousT = t;
-        Escape previous;
-        bool havePrevious = false;
-        double step3 = kInfinity;
-        double eps = epsilon(t);
-        for (int step = 0; step < settings_.maxSteps; ++step) {
-            const Escape escape = evaluateAt(origin + t * direction);
-            ++trace.steps;
-            eps = epsilon(t);
-            if (escape.n == 0) {
-                trace.hit = true;
-                if (!havePrevious) {
-                    trace.t = t;
-                    trace.escape = escape;
-                    trace.cutFace = step == 0 && bounds_.clipped && span.near > 0.0;
-                    return trace;
-                }
-                // The step jumped over the surface of the finite-N set (the DE bounds the
-                // distance to the limit set, math.md): bisect back to the last point outside.
-                double outside = previousT;
-                double inside = t;
-                for (int k = 0; k < kBisectionSteps; ++k) {
-                    const double middle = 0.5 * (outside + inside);
-                    const Escape probe = evaluateAt(origin + middle * direction);
-                    if (probe.n == 0) {
-                        inside = middle;
-                    } else {
-                        outside = middle;
-                        previous = probe;
-                    }
-                }
-                trace.t = outside;
-                trace.escape = previous;
-                return trace;
-            }
-            step3 = escape.de / stretch_;
-            if (!std::isfinite(step3)) step3 = settings_.maxStep;  // zero derivative: largest step
-            if (step3 < eps) {
-                trace.hit = true;
-                trace.t = t;
-                trace.escape = escape;
-                return trace;
-            }
-            previousT = t;
-            previous = escape;
-            havePrevious = true;
-            t += settings_.stepFactor * std::min(step3, settings_.maxStep);
-            if (t > span.far) return trace;
-        }
-        // Out of steps: close enough to count, or give up.
-        if (havePrevious && step3 < 10.0 * eps) {
-            trace.hit = true;
-            trace.t = previousT;
-            trace.escape = previous;
-        }
-        return trace;
+    template <class Result>  // Escape or Probe
+    double distance3(const Result& escape) const {
+        return escape.n == 0 ? 0.0 : escape.de / stretch_;
     }
 
-    glm::dvec3 normalAt(const glm::dvec3& p, const glm::dvec3& direction, const Trace& trace, double eps) const {
-        glm::dvec3 gradient(0.0);
-        if (trace.cutFace) {
-            gradient = p - bounds_.center;  // the sphere clips the set: its face is the surface
-        } else if (analytic_) {
-            gradient = realPartGradient(fractal_, slice_.map(p).a, realAxes_);
-        } else {
-            // Central differences of the DE; where one side is inside (DE clamped to 0, not
-            // negative) a one-sided difference from the hit point avoids bending the normal.
-            const double h = std::max(eps, 1e-6);
-            const double here = distance3(trace.escape);
-            for (int axis = 0; axis < 3; ++axis) {
-                glm::dvec3 offset(0.0);
-                offset[axis] = h;
-                const Escape plus = evaluateAt(p + offset);
-                const Escape minus = evaluateAt(p - offset);
-                const double dPlus = distance3(plus);
-                const double dMinus = distance3(minus);
-                if (plus.n != 0 && minus.n != 0) {
-                    gradient[axis] = (dPlus - dMinus) / (2.0 * h);
-                } else if (plus.n != 0) {
-                    gradient[axis] = (dPlus - here) / h;
-                } else if (minus.n != 0) {
-                    gradient[axis] = (here - dMinus) / h;
-                }
-            }
-        }
-        const double length = glm::length(gradient);
-        glm::dvec3 normal = length > 0.0 && std::isfinite(length) ? gradient / length : -direction;
-        if (glm::dot(normal, direction) > 0.0) normal = -normal;  // face the camera
-        return normal;
-    }
+    const Slice& slice() const { return slice_; }
+    const Fractal& fractal() const { return fractal_; }
 
-    glm::dvec3 palette(double value) const {
-        const auto& colours = material_.palette;
-        if (colours.empty()) return material_.color;
-        if (colours.size() == 1 || !(value > 0.0)) return colours.front();
-        if (value >= 1.0) return colours.back();
-        const double position = value * static_cast<double>(colours.size() - 1);
-        const auto index = static_cast<std::size_t>(position);
-        const double fraction = position - static_cast<double>(index);
-        return colours[index] * (1.0 - fraction) + colours[index + 1] * fraction;
-    }
-
-    glm::dvec3 baseColour(const Escape& escape) const {
-        switch (material_.coloring) {
-            case Coloring::Solid: return material_.color;
-            case Coloring::Iterations: {
-                if (escape.n == 0 || !(escape.r > 1.0)) return palette(1.0);
-                // Smooth escape count: the fraction of an iteration by which r overshot R.
-                const double smooth = escape.n + 1.0 - std::log2(std::log(escape.r) / std::log(fractal_.bailout));
-                return palette(smooth / fractal_.iterations);
-            }
-            case Coloring::Trap: return palette(escape.trap / trapScale_);
-        }
-        return material_.color;
-    }
-
-    /// 1 = open, 0 = fully occluded. Compares the DE at probes along the normal with their
-    /// height above the surface; the DE is about half the true distance (exactly half for the
-    /// ball, c = 0), so 2 * DE is the estimate of the free distance.
-    double occlusion(const glm::dvec3& p, const glm::dvec3& normal) const {
-        if (material_.occlusion <= 0.0) return 1.0;
-        double sum = 0.0;
-        double weight = 0.5;
-        double totalWeight = 0.0;
-        for (int i = 1; i <= kOcclusionSamples; ++i, weight *= 0.5) {
-            const double height = i * occlusionDelta_;
-            const double free = std::min(2.0 * distance3(evaluateAt(p + normal * height)), height);
-            sum += weight * (height - free) / height;
-            totalWeight += weight;
-        }
-        return std::clamp(1.0 - material_.occlusion * sum / totalWeight, 0.0, 1.0);
-    }
-
-    /// Soft shadow towards a directional light: 0 = blocked, 1 = lit; penumbra from the
-    /// closest miss along the way (k * d / t).
-    double shadow(const glm::dvec3& p, const glm::dvec3& normal, const glm::dvec3& toLight, double eps) const {
-        const glm::dvec3 origin = p + normal * (2.0 * eps);
-        const Interval span = intersectSphere(origin, toLight, bounds_);
-        if (!span.valid) return 1.0;
-        double result = 1.0;
-        double t = 2.0 * eps;
-        for (int step = 0; step < kShadowSteps && t < span.far; ++step) {
-            const Escape escape = evaluateAt(origin + t * toLight);
-            if (escape.n == 0) return 0.0;
-            double d = escape.de / stretch_;
-            if (!std::isfinite(d)) d = settings_.maxStep;
-            if (d < 0.25 * eps) return 0.0;
-            result = std::min(result, material_.shadowSoftness * d / t);
-            t += std::clamp(settings_.stepFactor * d, eps, settings_.maxStep);
-        }
-        return std::clamp(result, 0.0, 1.0);
-    }
-
-    /// Phong (the paper's equation) with occlusion on the ambient term and soft shadows.
-    glm::dvec3 shade(const glm::dvec3& p, const glm::dvec3& normal, const glm::dvec3& direction,
-                     const Escape& escape, double eps) const {
-        const glm::dvec3 base = baseColour(escape);
-        const double open = occlusion(p, normal);
-        glm::dvec3 colour = material_.ambient * open * base;
-        const glm::dvec3 toEye = -direction;
-        const double diffuseOcclusion = 0.7 + 0.3 * open;  // creases also lose some direct light
-        for (const auto& light : lights_) {
-            const double facing = glm::dot(normal, light.direction);
-            if (facing <= 0.0) continue;
-            const double lit = material_.shadows ? shadow(p, normal, light.direction, eps) : 1.0;
-            if (lit <= 0.0) continue;
-            const glm::dvec3 reflected = 2.0 * facing * normal - light.direction;
-            const double highlight = std::pow(std::max(0.0, glm::dot(reflected, toEye)), material_.shininess);
-            colour += (material_.diffuse * facing * diffuseOcclusion * base + material_.specular * highlight) *
-                      light.radiance * lit;
-        }
-        return colour;
-    }
+    glm::dvec3 baseColour(const Escape& escape) const { return orbitColour(material_, fractal_, escape); }
 
     /// Vertical gradient over the image: bottom colour at the bottom edge, top at the top.
     glm::dvec3 background(const glm::dvec3& direction) const {
@@ -291,6 +147,8 @@ public:
     }
 
 private:
+    friend class RayJob;
+
     struct ResolvedLight {
         glm::dvec3 direction;
         glm::dvec3 radiance;
@@ -310,7 +168,393 @@ private:
     Quat realAxes_[3];
     std::vector<ResolvedLight> lights_;
     double occlusionDelta_ = 0.02;
-    double trapScale_ = 1.0;
+};
+
+/// One camera ray, from the eye to its shaded colour, as a state machine. Each stage names the
+/// 3-D points whose escape it needs next (queries()) and moves on when given their escapes
+/// (answer()): sphere tracing, bisecting back to the surface, the normal's probes (central
+/// differences), the occlusion probes, and one soft-shadow march per lit light, side by side.
+/// The scalar engine answers each query at once with evaluate(); the packet engine gathers the
+/// queries of many rays and answers them together with the SIMD batch kernel (batch.hpp). Both
+/// run this same logic, so their pictures differ only by the kernel's rounding of the DE's
+/// logarithm.
+class RayJob {
+public:
+    RayJob(const Scene& scene, const glm::dvec3& direction) : scene_(&scene), direction_(direction) {
+        span_ = intersectSphere(scene.camera_.eye, direction, scene.bounds_);
+        if (!span_.valid || scene.empty_) {
+            finishMarch();
+            return;
+        }
+        t_ = previousT_ = span_.near;
+        stage_ = Stage::March;
+    }
+
+    bool done() const { return stage_ == Stage::Done; }
+    const Trace& trace() const { return trace_; }
+    /// The shaded colour for a hit, the background for a miss.
+    const glm::dvec3& colour() const { return colour_; }
+    const glm::dvec3& normal() const { return normal_; }
+
+    /// Appends the points this ray needs evaluated next; returns how many (0 once done).
+    std::size_t queries(std::vector<glm::dvec3>& points) const {
+        const glm::dvec3& eye = scene_->camera_.eye;
+        switch (stage_) {
+            case Stage::March: points.push_back(eye + t_ * direction_); return 1;
+            case Stage::Bisect: points.push_back(eye + 0.5 * (outside_ + inside_) * direction_); return 1;
+            case Stage::Normal:
+                for (int axis = 0; axis < 3; ++axis) {
+                    glm::dvec3 offset(0.0);
+                    offset[axis] = h_;
+                    points.push_back(p_ + offset);
+                    points.push_back(p_ - offset);
+                }
+                return 6;
+            case Stage::Occlusion:
+                for (int i = 1; i <= kOcclusionSamples; ++i) points.push_back(p_ + normal_ * (i * scene_->occlusionDelta_));
+                return kOcclusionSamples;
+            case Stage::Shadows: {
+                std::size_t count = 0;
+                for (const ShadowMarch& shadow : shadows_) {
+                    if (shadow.done) continue;
+                    points.push_back(shadow.origin + shadow.t * shadow.toLight);
+                    ++count;
+                }
+                return count;
+            }
+            case Stage::Done: return 0;
+        }
+        return 0;
+    }
+
+    /// Takes the escapes of the points the last queries() named, in order, and moves on.
+    void answer(const Probe* escapes) {
+        switch (stage_) {
+            case Stage::March: answerMarch(escapes[0]); return;
+            case Stage::Bisect: answerBisect(escapes[0]); return;
+            case Stage::Normal: answerNormal(escapes); return;
+            case Stage::Occlusion: answerOcclusion(escapes); return;
+            case Stage::Shadows: answerShadows(escapes); return;
+            case Stage::Done: return;
+        }
+    }
+
+private:
+    enum class Stage { March, Bisect, Normal, Occlusion, Shadows, Done };
+
+    /// A soft-shadow march towards one directional light: 0 = blocked, 1 = lit; penumbra from
+    /// the closest miss along the way (k * d / t).
+    struct ShadowMarch {
+        glm::dvec3 origin{0.0};
+        glm::dvec3 toLight{0.0};
+        double far = 0.0;
+        double t = 0.0;
+        double result = 1.0;
+        int step = 0;
+        bool done = true;
+        double lit = 1.0;
+    };
+
+    /// Sphere tracing: step by stepFactor * min(DE / stretch, maxStep) until the DE is below
+    /// the hit threshold or the ray leaves the bounds.
+    void answerMarch(const Probe& escape) {
+        const RenderSettings& settings = scene_->settings_;
+        ++trace_.steps;
+        eps_ = scene_->epsilon(t_);
+        if (escape.n == 0) {
+            trace_.hit = true;
+            if (!havePrevious_) {
+                trace_.t = t_;
+                trace_.escape = escape;
+                trace_.cutFace = step_ == 0 && scene_->bounds_.clipped && span_.near > 0.0;
+                finishMarch();
+                return;
+            }
+            // The step jumped over the surface of the finite-N set (the DE bounds the
+            // distance to the limit set, math.md): bisect back to the last point outside.
+            outside_ = previousT_;
+            inside_ = t_;
+            stage_ = Stage::Bisect;
+            return;
+        }
+        step3_ = escape.de / scene_->stretch_;
+        if (!std::isfinite(step3_)) step3_ = settings.maxStep;  // zero derivative: largest step
+        if (step3_ < eps_) {
+            trace_.hit = true;
+            trace_.t = t_;
+            trace_.escape = escape;
+            finishMarch();
+            return;
+        }
+        previousT_ = t_;
+        previous_ = escape;
+        havePrevious_ = true;
+        t_ += settings.stepFactor * std::min(step3_, settings.maxStep);
+        if (t_ > span_.far) {
+            finishMarch();
+            return;
+        }
+        if (++step_ == settings.maxSteps) {
+            // Out of steps: close enough to count, or give up.
+            if (step3_ < 10.0 * eps_) {
+                trace_.hit = true;
+                trace_.t = previousT_;
+                trace_.escape = previous_;
+            }
+            finishMarch();
+        }
+    }
+
+    /// Halves [outside, inside] kBisectionSteps times; the hit is the last point outside.
+    void answerBisect(const Probe& probe) {
+        const double middle = 0.5 * (outside_ + inside_);
+        if (probe.n == 0) {
+            inside_ = middle;
+        } else {
+            outside_ = middle;
+            previous_ = probe;
+        }
+        if (++bisection_ == kBisectionSteps) {
+            trace_.t = outside_;
+            trace_.escape = previous_;
+            finishMarch();
+        }
+    }
+
+    /// A miss takes the background; a hit goes on to its normal.
+    void finishMarch() {
+        const Scene& scene = *scene_;
+        if (!trace_.hit) {
+            colour_ = scene.background(direction_);
+            stage_ = Stage::Done;
+            return;
+        }
+        p_ = scene.camera_.eye + trace_.t * direction_;
+        hitEps_ = scene.epsilon(trace_.t);
+        if (trace_.cutFace) {
+            finishNormal(p_ - scene.bounds_.center);  // the sphere clips the set: its face is the surface
+        } else if (scene.analytic_) {
+            finishNormal(realPartGradient(scene.fractal_, scene.slice_.map(p_).a, scene.realAxes_));
+        } else {
+            h_ = std::max(hitEps_, 1e-6);
+            stage_ = Stage::Normal;
+        }
+    }
+
+    /// Central differences of the DE; where one side is inside (DE clamped to 0, not negative) a
+    /// one-sided difference from the hit point avoids bending the normal.
+    void answerNormal(const Probe* probes) {
+        const double here = scene_->distance3(trace_.escape);
+        glm::dvec3 gradient(0.0);
+        for (int axis = 0; axis < 3; ++axis) {
+            const Probe& plus = probes[2 * axis];
+            const Probe& minus = probes[2 * axis + 1];
+            const double dPlus = scene_->distance3(plus);
+            const double dMinus = scene_->distance3(minus);
+            if (plus.n != 0 && minus.n != 0) {
+                gradient[axis] = (dPlus - dMinus) / (2.0 * h_);
+            } else if (plus.n != 0) {
+                gradient[axis] = (dPlus - here) / h_;
+            } else if (minus.n != 0) {
+                gradient[axis] = (here - dMinus) / h_;
+            }
+        }
+        finishNormal(gradient);
+    }
+
+    void finishNormal(const glm::dvec3& gradient) {
+        const double length = glm::length(gradient);
+        normal_ = length > 0.0 && std::isfinite(length) ? gradient / length : -direction_;
+        if (glm::dot(normal_, direction_) > 0.0) normal_ = -normal_;  // face the camera
+        if (scene_->material_.occlusion > 0.0) {
+            stage_ = Stage::Occlusion;
+        } else {
+            open_ = 1.0;
+            startShadows();
+        }
+    }
+
+    /// Ambient occlusion, 1 = open, 0 = fully occluded. Compares the DE at probes along the
+    /// normal with their height above the surface; the DE is about half the true distance
+    /// (exactly half for the ball, c = 0), so 2 * DE is the estimate of the free distance.
+    void answerOcclusion(const Probe* probes) {
+        double sum = 0.0;
+        double weight = 0.5;
+        double totalWeight = 0.0;
+        for (int i = 1; i <= kOcclusionSamples; ++i, weight *= 0.5) {
+            const double height = i * scene_->occlusionDelta_;
+            const double free = std::min(2.0 * scene_->distance3(probes[i - 1]), height);
+            sum += weight * (height - free) / height;
+            totalWeight += weight;
+        }
+        open_ = std::clamp(1.0 - scene_->material_.occlusion * sum / totalWeight, 0.0, 1.0);
+        startShadows();
+    }
+
+    /// One shadow march for every light the surface faces (when shadows are on).
+    void startShadows() {
+        const Scene& scene = *scene_;
+        shadows_.assign(scene.lights_.size(), ShadowMarch{});
+        bool marching = false;
+        for (std::size_t index = 0; index < scene.lights_.size(); ++index) {
+            const glm::dvec3& toLight = scene.lights_[index].direction;
+            if (!scene.material_.shadows || glm::dot(normal_, toLight) <= 0.0) continue;
+            ShadowMarch& shadow = shadows_[index];
+            shadow.origin = p_ + normal_ * (2.0 * hitEps_);
+            shadow.toLight = toLight;
+            const Interval span = intersectSphere(shadow.origin, toLight, scene.bounds_);
+            if (!span.valid) continue;
+            shadow.far = span.far;
+            shadow.t = 2.0 * hitEps_;
+            shadow.done = !(kShadowSteps > 0 && shadow.t < shadow.far);
+            marching = marching || !shadow.done;
+        }
+        if (marching) {
+            stage_ = Stage::Shadows;
+        } else {
+            finishShading();
+        }
+    }
+
+    void answerShadows(const Probe* escapes) {
+        const Scene& scene = *scene_;
+        bool marching = false;
+        for (ShadowMarch& shadow : shadows_) {
+            if (shadow.done) continue;
+            const Probe& escape = *escapes++;
+            double d = escape.de / scene.stretch_;
+            if (!std::isfinite(d)) d = scene.settings_.maxStep;
+            if (escape.n == 0 || d < 0.25 * hitEps_) {
+                shadow.result = 0.0;
+                shadow.done = true;
+            } else {
+                shadow.result = std::min(shadow.result, scene.material_.shadowSoftness * d / shadow.t);
+                shadow.t += std::clamp(scene.settings_.stepFactor * d, hitEps_, scene.settings_.maxStep);
+                shadow.done = !(++shadow.step < kShadowSteps && shadow.t < shadow.far);
+            }
+            if (shadow.done) shadow.lit = std::clamp(shadow.result, 0.0, 1.0);
+            marching = marching || !shadow.done;
+        }
+        if (!marching) finishShading();
+    }
+
+    /// Phong (the paper's equation) with occlusion on the ambient term and soft shadows.
+    void finishShading() {
+        const Scene& scene = *scene_;
+        const Material& material = scene.material_;
+        const glm::dvec3 base = scene.baseColour(trace_.escape.escape());
+        glm::dvec3 colour = material.ambient * open_ * base;
+        const glm::dvec3 toEye = -direction_;
+        const double diffuseOcclusion = 0.7 + 0.3 * open_;  // creases also lose some direct light
+        for (std::size_t index = 0; index < scene.lights_.size(); ++index) {
+            const auto& light = scene.lights_[index];
+            const double facing = glm::dot(normal_, light.direction);
+            if (facing <= 0.0) continue;
+            const double lit = material.shadows ? shadows_[index].lit : 1.0;
+            if (lit <= 0.0) continue;
+            const glm::dvec3 reflected = 2.0 * facing * normal_ - light.direction;
+            const double highlight = std::pow(std::max(0.0, glm::dot(reflected, toEye)), material.shininess);
+            colour += (material.diffuse * facing * diffuseOcclusion * base + material.specular * highlight) *
+                      light.radiance * lit;
+        }
+        colour_ = colour;
+        stage_ = Stage::Done;
+    }
+
+    const Scene* scene_;
+    glm::dvec3 direction_;
+    Stage stage_ = Stage::Done;
+    Trace trace_;
+    // Sphere tracing and bisection.
+    Interval span_;
+    double t_ = 0.0;
+    double previousT_ = 0.0;
+    double step3_ = kInfinity;
+    double eps_ = 0.0;
+    Probe previous_;
+    bool havePrevious_ = false;
+    int step_ = 0;
+    double outside_ = 0.0;
+    double inside_ = 0.0;
+    int bisection_ = 0;
+    // The surface point and its shading.
+    glm::dvec3 p_{0.0};
+    glm::dvec3 normal_{0.0};
+    glm::dvec3 colour_{0.0};
+    double hitEps_ = 0.0;
+    double h_ = 0.0;  // central-difference step
+    double open_ = 1.0;
+    std::vector<ShadowMarch> shadows_;  // one per light
+};
+
+/// Answers the queries of ray jobs until every job is done: one query at a time with evaluate()
+/// (the scalar engine, the reference), or the queries of all unfinished jobs together through
+/// the SIMD batch kernel, round after round, finished jobs retiring (the packet engine).
+/// Holds only buffers, so one per thread is reused from tile to tile.
+class Evaluator {
+public:
+    void run(const Scene& scene, RenderEngine engine, std::vector<RayJob>& jobs) {
+        if (engine == RenderEngine::Scalar) {
+            for (RayJob& job : jobs) {
+                while (!job.done()) {
+                    points_.clear();
+                    job.queries(points_);
+                    probes_.clear();
+                    for (const glm::dvec3& p : points_) probes_.push_back(Probe::of(scene.evaluateAt(p)));
+                    job.answer(probes_.data());
+                }
+            }
+            return;
+        }
+        active_.clear();
+        for (std::size_t index = 0; index < jobs.size(); ++index)
+            if (!jobs[index].done()) active_.push_back(index);
+        while (!active_.empty()) {
+            points_.clear();
+            counts_.clear();
+            for (const std::size_t index : active_) counts_.push_back(jobs[index].queries(points_));
+            evaluateBatch(scene);
+            std::size_t offset = 0;
+            std::size_t kept = 0;
+            for (std::size_t k = 0; k < active_.size(); ++k) {
+                RayJob& job = jobs[active_[k]];
+                job.answer(probes_.data() + offset);
+                offset += counts_[k];
+                if (!job.done()) active_[kept++] = active_[k];
+            }
+            active_.resize(kept);
+        }
+    }
+
+private:
+    /// points_ -> probes_ through the SIMD kernel. The 8-D coordinates are Slice::map's
+    /// expression, coordinate by coordinate, so they round the same; terms with a zero axis
+    /// component are left out (they add a zero, which changes at most the sign of a zero).
+    void evaluateBatch(const Scene& scene) {
+        const std::size_t count = points_.size();
+        const Slice& slice = scene.slice();
+        batch_.resize(count);
+        for (int k = 0; k < 8; ++k) {
+            double* out = batch_.start(k);
+            const double origin = slice.origin[k];
+            std::fill(out, out + count, origin);
+            for (int axis = 0; axis < 3; ++axis) {
+                const double scale = slice.axes[axis][k];
+                if (scale == 0.0) continue;
+                for (std::size_t i = 0; i < count; ++i) out[i] += points_[i][axis] * scale;
+            }
+        }
+        batch_.evaluate(scene.fractal());
+        probes_.resize(count);
+        for (std::size_t i = 0; i < count; ++i)
+            probes_[i] = {batch_.n(i), batch_.r(i), batch_.ra(i), batch_.rb(i), batch_.de(i), batch_.trap(i)};
+    }
+
+    std::vector<glm::dvec3> points_;
+    std::vector<Probe> probes_;
+    std::vector<std::size_t> counts_;
+    std::vector<std::size_t> active_;
+    BatchBuffer<double> batch_;
 };
 
 struct TileStats {
@@ -319,41 +563,52 @@ struct TileStats {
     std::uint64_t hitPixels = 0;
 };
 
-TileStats renderTile(const Scene& scene, int x0, int y0, int x1, int y1, Image& image) {
+TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, int x1, int y1, Image& image) {
     TileStats stats;
     const CameraFrame& camera = scene.camera();
     const int samples = scene.samples();
-    const double weight = 1.0 / (samples * samples);
-    for (int y = y0; y < y1; ++y) {
-        for (int x = x0; x < x1; ++x) {
-            glm::dvec3 colour(0.0);
-            glm::dvec3 surfaceColour(0.0);
-            glm::dvec3 normalSum(0.0);
-            double depth = kInfinity;
-            int hits = 0;
+    const int perPixel = samples * samples;
+    const double weight = 1.0 / perPixel;
+    const int width = x1 - x0;
+    const int pixels = width * (y1 - y0);
+    // The tile's pixels go through in passes of about kRaysPerPass rays, whole pixels at a time.
+    const int pixelsPerPass = std::max(1, kRaysPerPass / perPixel);
+    thread_local Evaluator evaluator;
+    thread_local std::vector<RayJob> jobs;
+    for (int first = 0; first < pixels; first += pixelsPerPass) {
+        const int last = std::min(pixels, first + pixelsPerPass);
+        jobs.clear();
+        for (int index = first; index < last; ++index) {
+            const int x = x0 + index % width;
+            const int y = y0 + index / width;
             for (int sy = 0; sy < samples; ++sy) {
                 for (int sx = 0; sx < samples; ++sx) {
                     // A regular grid of sub-pixel positions; with one sample, the pixel centre.
                     const double px = x + (sx + 0.5) / samples;
                     const double py = y + (sy + 0.5) / samples;
-                    const glm::dvec3 direction = camera.rayDirection(px, py);
-                    const Trace trace = scene.march(camera.eye, direction);
-                    ++stats.rays;
-                    stats.steps += trace.steps;
-                    if (!trace.hit) {
-                        colour += scene.background(direction);
-                        continue;
-                    }
-                    const glm::dvec3 p = camera.eye + trace.t * direction;
-                    const double eps = scene.epsilon(trace.t);
-                    const glm::dvec3 normal = scene.normalAt(p, direction, trace, eps);
-                    const glm::dvec3 shaded = scene.shade(p, normal, direction, trace.escape, eps);
-                    colour += shaded;
-                    surfaceColour += shaded;
-                    normalSum += normal;
-                    depth = std::min(depth, trace.t);
-                    ++hits;
+                    jobs.emplace_back(scene, camera.rayDirection(px, py));
                 }
+            }
+        }
+        evaluator.run(scene, engine, jobs);
+        for (int index = first; index < last; ++index) {
+            const int x = x0 + index % width;
+            const int y = y0 + index / width;
+            glm::dvec3 colour(0.0);
+            glm::dvec3 surfaceColour(0.0);
+            glm::dvec3 normalSum(0.0);
+            double depth = kInfinity;
+            int hits = 0;
+            for (int sample = 0; sample < perPixel; ++sample) {
+                const RayJob& job = jobs[static_cast<std::size_t>(index - first) * perPixel + sample];
+                ++stats.rays;
+                stats.steps += job.trace().steps;
+                colour += job.colour();
+                if (!job.trace().hit) continue;
+                surfaceColour += job.colour();
+                normalSum += job.normal();
+                depth = std::min(depth, job.trace().t);
+                ++hits;
             }
             const std::size_t pixel = static_cast<std::size_t>(y) * image.width + x;
             colour *= weight;
@@ -375,6 +630,40 @@ TileStats renderTile(const Scene& scene, int x0, int y0, int x1, int y1, Image& 
 }
 
 }  // namespace
+
+namespace {
+
+glm::dvec3 paletteAt(const Material& material, double value) {
+    const auto& colours = material.palette;
+    if (colours.empty()) return material.color;
+    if (colours.size() == 1 || !(value > 0.0)) return colours.front();
+    if (value >= 1.0) return colours.back();
+    const double position = value * static_cast<double>(colours.size() - 1);
+    const auto index = static_cast<std::size_t>(position);
+    const double fraction = position - static_cast<double>(index);
+    return colours[index] * (1.0 - fraction) + colours[index + 1] * fraction;
+}
+
+}  // namespace
+
+glm::dvec3 orbitColour(const Material& material, const Fractal& fractal, const Escape& escape) {
+    switch (material.coloring) {
+        case Coloring::Solid: return material.color;
+        case Coloring::Iterations: {
+            if (escape.n == 0 || !(escape.r > 1.0)) return paletteAt(material, 1.0);
+            // Smooth escape count: the fraction of an iteration by which r overshot R.
+            const double smooth = escape.n + 1.0 - std::log2(std::log(escape.r) / std::log(fractal.bailout));
+            return paletteAt(material, smooth / fractal.iterations);
+        }
+        case Coloring::Trap: {
+            // The orbit's closest approach to 0 ranges over [0, r_K(c_a)] and is mostly below half
+            // of it on the surface; scaling by 0.65 r_K spreads the default set's values over the
+            // whole palette.
+            return paletteAt(material, escape.trap / (0.65 * containmentRadius(fractal.c.a)));
+        }
+    }
+    return material.color;
+}
 
 glm::dvec3 CameraFrame::rayDirection(double px, double py) const {
     const double aspect = static_cast<double>(width) / height;
@@ -431,7 +720,7 @@ CameraFrame frameCamera(const Params& params, const Bounds& bounds) {
     return frame;
 }
 
-RenderResult render(const Params& params, const ProgressCallback& progress) {
+RenderResult render(const Params& params, const ProgressCallback& progress, RenderEngine engine) {
     validate(params);
     const auto start = std::chrono::steady_clock::now();
     const Scene scene(params, !provenEmptyReason(params).empty());
@@ -455,7 +744,7 @@ RenderResult render(const Params& params, const ProgressCallback& progress) {
         static_cast<std::size_t>(tilesX) * tilesY, progress, [&](std::size_t index, const std::atomic<bool>&) {
             const int x0 = static_cast<int>(index % tilesX) * kTileSize;
             const int y0 = static_cast<int>(index / tilesX) * kTileSize;
-            const TileStats tile = renderTile(scene, x0, y0, std::min(x0 + kTileSize, image.width),
+            const TileStats tile = renderTile(scene, engine, x0, y0, std::min(x0 + kTileSize, image.width),
                                               std::min(y0 + kTileSize, image.height), image);
             rays += tile.rays;
             steps += tile.steps;

@@ -18,7 +18,7 @@
 namespace dqj {
 
 struct SheetTile {
-    Image image;        ///< rgba is used; tiles may differ in size (cells take the largest)
+    Image image;        ///< rgba is used; tiles may differ in size (columns take the widest, rows their tallest)
     std::string label;  ///< "\n" separates lines; long lines wrap
 };
 

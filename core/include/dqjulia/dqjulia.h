@@ -13,7 +13,8 @@
  * Thread safety: dqj_version*() and dqj_status_string() may be called from any thread.
  * Separate contexts are independent and may be used from different threads at the same
  * time. One context must not be used from two threads at once (calls on it are not
- * serialised); its progress callback runs on the thread that called dqj_render*().
+ * serialised); its progress callback runs on the thread that called dqj_render*(),
+ * dqj_bake_vdb() or dqj_mesh_compute().
  */
 #ifndef DQJULIA_H
 #define DQJULIA_H
@@ -120,6 +121,57 @@ DQJ_API dqj_status dqj_render_to_file(dqj_context context, const char* path, dqj
  * membership, bounds, inside fraction and, when the slice is empty, the reason. Same
  * buffer convention as dqj_context_get_params_json. */
 DQJ_API dqj_status dqj_inspect_json(dqj_context context, char* buffer, size_t capacity, size_t* out_size);
+
+/* ---- Baking: OpenVDB volumes and meshes (README, "Baking") ----------------------------------
+ * Bakes and meshes use the context's parameters at its current frame (dqj_context_set_frame)
+ * and their "bake" section: resolution, bounds, band width, which grids, mesh adaptivity and
+ * vertex colours. Set that section with dqj_context_set_params_json, or the resolution alone
+ * with dqj_context_set_bake_resolution. Coordinates are the slice's x, y, z. */
+
+/* Voxels across the largest side of the bake bounds, 8..16384 (sets bake.resolution). */
+DQJ_API dqj_status dqj_context_set_bake_resolution(dqj_context context, int resolution);
+/* The frame at which keyframed parameters (the parameter file's "animation") are taken by
+ * renders, bakes and meshes on this context. Default 1. Without keyframes it changes nothing. */
+DQJ_API dqj_status dqj_context_set_frame(dqj_context context, double frame);
+/* Bakes and meshes whose estimated memory exceeds `bytes` are refused before any heavy work
+ * (DQJ_ERROR_OUT_OF_MEMORY, the message gives the estimate). 0 (the default) means half of the
+ * memory available when the work starts. */
+DQJ_API dqj_status dqj_context_set_memory_limit(dqj_context context, uint64_t bytes);
+
+/* Bakes an OpenVDB file at `path`: the level set "surface", the fog volume "density" and the
+ * attribute grids bake.grids asks for. The file appears only when complete: after a failure or
+ * a cancel an existing file at `path` is untouched and no temporary file remains. */
+DQJ_API dqj_status dqj_bake_vdb(dqj_context context, const char* path, dqj_progress_fn progress, void* user_data);
+
+/* Meshes the surface (OpenVDB volumeToMesh at the bake resolution and bake.adaptivity) and keeps
+ * the mesh in the context, replacing the previous one (which is kept if this call fails). */
+DQJ_API dqj_status dqj_mesh_compute(dqj_context context, dqj_progress_fn progress, void* user_data);
+/* The sizes of the context's mesh: vertices, and triangles (quads count as two). 0 and 0 before
+ * the first dqj_mesh_compute. Either pointer may be NULL. */
+DQJ_API dqj_status dqj_mesh_get_sizes(dqj_context context, size_t* out_vertex_count, size_t* out_triangle_count);
+/* Copies the context's mesh into caller-owned buffers sized by dqj_mesh_get_sizes:
+ *   positions  3 floats a vertex (x, y, z);
+ *   normals    3 floats a vertex, unit, pointing out of the solid; NULL to skip;
+ *   colors     3 floats a vertex, linear RGB from the material's colouring; NULL to skip (and
+ *              NULL is required when bake.mesh_colors was false: the mesh then has none);
+ *   triangles  3 vertex indices a triangle, counter-clockwise seen from outside.
+ * vertex_capacity and triangle_capacity are the buffers' sizes in vertices and triangles;
+ * too small gives DQJ_ERROR_INVALID_ARGUMENT and copies nothing. */
+DQJ_API dqj_status dqj_mesh_copy(dqj_context context, float* positions, float* normals, float* colors,
+                                 size_t vertex_capacity, uint32_t* triangles, size_t triangle_capacity);
+/* Writes the context's mesh to `path`: .ply (binary, with normals and colours) or .obj. Same
+ * all-or-nothing file behaviour as dqj_bake_vdb. */
+DQJ_API dqj_status dqj_mesh_write(dqj_context context, const char* path);
+
+/* What the context's last successful bake or mesh cost. */
+typedef struct dqj_bake_stats {
+    uint64_t voxels_evaluated; /* fractal evaluations, including the block tests */
+    uint64_t voxels_dense;     /* voxels of the whole grid: what a dense bake evaluates */
+    uint64_t active_voxels;    /* active voxels of the "surface" level set (bakes; 0 for meshes) */
+    uint64_t estimated_bytes;  /* the memory estimate checked against the limit */
+    double seconds;            /* wall-clock time */
+} dqj_bake_stats;
+DQJ_API dqj_status dqj_bake_get_stats(dqj_context context, dqj_bake_stats* out_stats);
 
 #ifdef __cplusplus
 }

@@ -79,6 +79,43 @@ struct OutputSettings {
     std::optional<ImageFormat> format;  ///< default: from the file extension
 };
 
+/// A box in slice coordinates (bake.bounds).
+struct Box {
+    glm::dvec3 min{-1.0};
+    glm::dvec3 max{1.0};
+};
+
+/// The grids a bake can write (bake.grids). README "Baking" says what each holds.
+enum class BakeGrid { Surface, Density, Color, Trap, Iterations };
+
+/// The "bake" section: OpenVDB volumes and meshes (bake.hpp, mesh.hpp).
+struct BakeSettings {
+    int resolution = 256;       ///< voxels across the largest side of the bounds
+    std::optional<Box> bounds;  ///< default: the cube around the render bounds' sphere, clipped to the sphere
+    double bandWidth = 3.0;     ///< half width of the level set's narrow band, in voxels
+    std::vector<BakeGrid> grids{BakeGrid::Surface, BakeGrid::Density};
+    double adaptivity = 0.0;    ///< mesh adaptivity 0..1 (OpenVDB volumeToMesh): 0 = uniform quads
+    bool meshColors = true;     ///< vertex colours from the material's colouring
+};
+
+/// Keyframes: the parameter file's "animation" section (README "Animation").
+enum class Interpolation {
+    Linear,  ///< straight line to the next key
+    Smooth   ///< monotone cubic: smooth through the keys, never overshooting them
+};
+struct Keyframe {
+    double frame = 1.0;
+    std::vector<double> value;  ///< 8 numbers for fractal.c, 1 otherwise
+    Interpolation interpolation = Interpolation::Linear;  ///< from this key to the next
+};
+/// What a track animates.
+enum class AnimatedValue { Constant, Iterations, Bailout, RotationDegrees };
+struct Track {
+    AnimatedValue target = AnimatedValue::Constant;
+    int rotation = 0;             ///< for RotationDegrees: the index into slice.rotations
+    std::vector<Keyframe> keys;   ///< at least one, frames strictly increasing
+};
+
 struct Params {
     std::string description;  ///< free text, kept on round trips (examples say what they show)
     Fractal fractal;
@@ -90,6 +127,8 @@ struct Params {
     Material material;
     RenderSettings render;
     OutputSettings output;
+    BakeSettings bake;
+    std::vector<Track> animation;  ///< empty: nothing is animated
 };
 
 /// A bad parameter: `key` is the dotted path ("fractal.iterations"), `what()` the full message.
@@ -125,5 +164,14 @@ DQJ_API std::string_view normalMethodName(NormalMethod method);
 DQJ_API std::string_view imageFormatName(ImageFormat format);
 /// The format for a path: from `output.format` if set, else from its extension (.png, .exr).
 DQJ_API ImageFormat formatFor(const OutputSettings& output);
+
+/// The parameters at `frame`: every animated value replaced by its track's value there (before
+/// the first key the first value holds, after the last the last); iterations round to the
+/// nearest whole number. Not validated: call validate() on the result. Without tracks, a copy.
+DQJ_API Params atFrame(const Params& params, double frame);
+/// "fractal.c", "fractal.iterations", "fractal.bailout" or "slice.rotations[i].degrees".
+DQJ_API std::string trackKey(const Track& track);
+DQJ_API std::string_view bakeGridName(BakeGrid grid);
+DQJ_API bool hasGrid(const BakeSettings& bake, BakeGrid grid);
 
 }  // namespace dqj

@@ -4,7 +4,8 @@
 // stepFactor * min(DE / stretch, maxStep) until the DE falls below the pixel footprint
 // (times `detail`). Shading: Phong (the paper's equation, several lights), ambient
 // occlusion and soft shadows from the DE, orbit colouring, background gradient,
-// samples x samples anti-aliasing. Work is split in tiles over TBB threads.
+// samples x samples anti-aliasing. Work is split in tiles over TBB threads; the rays of a tile
+// march together, their points evaluated many at a time by the SIMD batch kernel (batch.hpp).
 // Cost: about width * height * samples^2 * (steps per ray) * N quaternion iterations.
 #pragma once
 
@@ -50,9 +51,21 @@ struct RenderResult {
     RenderStats stats;
 };
 
+/// How the renderer evaluates the fractal. Both run the same marching and shading logic.
+enum class RenderEngine {
+    Packet,  ///< the rays of a tile together, through the SIMD batch kernel (batch.hpp); the default
+    Scalar   ///< one point at a time with evaluate(): the reference the packet engine is tested against
+};
+
 /// Renders the parameter set. A slice proven empty (provenEmptyReason in inspect.hpp) renders
 /// as background only. Throws ParamError for invalid parameters, Cancelled if
 /// `progress` returned false.
-DQJ_API RenderResult render(const Params& params, const ProgressCallback& progress = {});
+DQJ_API RenderResult render(const Params& params, const ProgressCallback& progress = {},
+                            RenderEngine engine = RenderEngine::Packet);
+
+/// The material's colour (linear RGB) for a point with this escape result: `solid` gives
+/// material.color, `iterations` maps the smooth escape count and `trap` the orbit trap through
+/// the palette. The renderer shades with it; the bake colours mesh vertices and volumes with it.
+DQJ_API glm::dvec3 orbitColour(const Material& material, const Fractal& fractal, const Escape& escape);
 
 }  // namespace dqj

@@ -1,0 +1,427 @@
+#!/usr/bin/python3
+"""bench/compare.py - dqjulia against POV-Ray and Mandelbulber 2 on the same quaternion Julia set.
+
+Measures, in one run on this machine, and prints a table of ratios:
+  1. render: a 640x480 image of the quaternion Julia set c = (-0.39054, -0.58679, 0, 0), N = 12,
+     by `dqjulia render` (variant dual, zero dual constant) against POV-Ray's built-in
+     julia_fractal with the same constant, bailout, camera, lights and size; wall-clock and CPU
+     time, a silhouette overlap check (IoU) and a speckle measure for each picture;
+  2. mesh at 256^3 and 512^3 by `dqjulia mesh` against Mandelbulber 2's marching-cubes PLY export
+     (`mandelbulber2 -n -V ply`) of the same set and box; time and peak memory;
+  3. bake (`dqjulia bake`, an OpenVDB level set) at 256^3, 512^3 and 1024^3, and the growth
+     exponent of its time with the resolution (2 = proportional to the surface, 3 = to the volume);
+  4. the SIMD kernel against the scalar one (bench/kernel_bench.cpp), if it was built.
+
+Same set in all three programs: with a zero dual constant the dual variant iterates the
+quaternion a <- a^2 + c; with c's k component 0 the slice k = 0 stays k = 0, which is exactly
+Mandelbulber's 3-D "quaternion" formula (formula 5, Julia mode); POV-Ray's julia_fractal fixes
+the bailout at R = min(1 + |c|, 2) and tests |z| > R *before* each iteration, so its
+max_iteration 13 tests z_0..z_12 as our N = 12 tests z_1..z_12 (z_0 lies inside the bounding
+sphere anyway). Mandelbulber's mesh is the level set of its distance estimate at half a voxel,
+not the escape set, so its surface sits slightly outside ours.
+
+Usage: bench/compare.py [--build DIR] [--repeat N] [--skip-mesh] [--skip-bake] [--skip-kernel]
+                        [--mesh-resolutions 256,512] [--bake-resolutions 256,512,1024] [--keep DIR]
+Installs povray and mandelbulber2 with apt-get if they are missing (needs root). Times are
+medians of --repeat runs (default 3), the programs interleaved, so both see the same machine
+load; peak memory is the largest resident set (/usr/bin/time -v). The machine may be busy with
+other work: the ratios are the meaningful figures, the absolute times less so.
+"""
+import argparse
+import math
+import os
+import re
+import shutil
+import statistics
+import struct
+import subprocess
+import sys
+import tempfile
+import zlib
+
+C = (-0.39054, -0.58679, 0.0, 0.0)
+N = 12
+WIDTH, HEIGHT = 640, 480
+FOV = 40.0  # vertical, degrees
+EYE = (2.2, 1.8, 4.0)
+TARGET = (0.0, 0.0, 0.0)
+BOX = 1.5  # the mesh and bake box: [-1.5, 1.5]^3
+MAGENTA = (255, 0, 255)  # flat background of both renders, so silhouettes can be read off the pixels
+LIGHTS = [((0.6, 0.8, 0.7), (1.0, 0.96, 0.9)), ((-0.7, 0.2, -0.5), (0.55 * 0.35, 0.65 * 0.35, 0.9 * 0.35))]
+
+
+def bailout():
+    """POV-Ray's julia_fractal bailout for quaternion sqr: min(1 + |c|, 2) (plus 1e-7)."""
+    return min(1.0 + math.sqrt(sum(x * x for x in C)), 2.0)
+
+
+# ---------------------------------------------------------------- running and measuring
+
+
+def ensure_installed(program, package):
+    if shutil.which(program):
+        return True
+    print(f"{program} is missing: apt-get install -y {package}", flush=True)
+    env = dict(os.environ, DEBIAN_FRONTEND="noninteractive")
+    subprocess.run(["apt-get", "install", "-y", package], env=env, check=False, stdout=subprocess.DEVNULL)
+    return shutil.which(program) is not None
+
+
+def timed(command, cwd=None):
+    """Runs `command` under /usr/bin/time -v; returns wall seconds, CPU seconds, peak KB, stdout."""
+    result = subprocess.run(["/usr/bin/time", "-v"] + command, cwd=cwd, capture_output=True, text=True)
+    if result.returncode != 0:
+        raise RuntimeError(f"{' '.join(command)} failed ({result.returncode}):\n{result.stdout[-2000:]}\n{result.stderr[-2000:]}")
+    text = result.stderr
+    wall = re.search(r"Elapsed \(wall clock\) time \(h:mm:ss or m:ss\): (\S+)", text).group(1)
+    seconds = 0.0
+    for part in wall.split(":"):
+        seconds = seconds * 60 + float(part)
+    user = float(re.search(r"User time \(seconds\): (\S+)", text).group(1))
+    system = float(re.search(r"System time \(seconds\): (\S+)", text).group(1))
+    peak = int(re.search(r"Maximum resident set size \(kbytes\): (\d+)", text).group(1))
+    return {"wall": seconds, "cpu": user + system, "peak_kb": peak, "stdout": result.stdout}
+
+
+def median_runs(commands, repeat, cwd=None):
+    """Runs each command `repeat` times, interleaved; returns per command the median wall and CPU
+    seconds and the largest peak memory."""
+    runs = {name: [] for name in commands}
+    for _ in range(repeat):
+        for name, command in commands.items():
+            runs[name].append(timed(command, cwd))
+    summary = {}
+    for name, results in runs.items():
+        summary[name] = {
+            "wall": statistics.median(r["wall"] for r in results),
+            "cpu": statistics.median(r["cpu"] for r in results),
+            "peak_kb": max(r["peak_kb"] for r in results),
+            "stdout": results[-1]["stdout"],
+        }
+    return summary
+
+
+# ---------------------------------------------------------------- images (PNG decoding, no numpy)
+
+
+def read_png(path):
+    """8-bit RGB or RGBA, non-interlaced PNG -> (width, height, rows of (r, g, b) tuples)."""
+    data = open(path, "rb").read()
+    assert data[:8] == b"\x89PNG\r\n\x1a\n", path
+    position, idat, width = 8, b"", 0
+    while position < len(data):
+        length, kind = struct.unpack(">I4s", data[position:position + 8])
+        body = data[position + 8:position + 8 + length]
+        if kind == b"IHDR":
+            width, height, depth, colour, _, _, interlace = struct.unpack(">IIBBBBB", body)
+            if depth != 8 or colour not in (2, 6) or interlace:
+                raise ValueError(f"{path}: only 8-bit RGB/RGBA non-interlaced PNG is read here")
+            channels = 3 if colour == 2 else 4
+        elif kind == b"IDAT":
+            idat += body
+        position += 12 + length
+    raw = zlib.decompress(idat)
+    stride = width * channels
+    rows, previous = [], bytearray(stride)
+    for y in range(height):
+        start = y * (stride + 1)
+        kind, line = raw[start], bytearray(raw[start + 1:start + 1 + stride])
+        for i in range(stride):
+            left = line[i - channels] if i >= channels else 0
+            up = previous[i]
+            upper_left = previous[i - channels] if i >= channels else 0
+            if kind == 1:
+                line[i] = (line[i] + left) & 255
+            elif kind == 2:
+                line[i] = (line[i] + up) & 255
+            elif kind == 3:
+                line[i] = (line[i] + (left + up) // 2) & 255
+            elif kind == 4:
+                p = left + up - upper_left
+                pa, pb, pc = abs(p - left), abs(p - up), abs(p - upper_left)
+                line[i] = (line[i] + (left if pa <= pb and pa <= pc else up if pb <= pc else upper_left)) & 255
+        rows.append([tuple(line[x * channels:x * channels + 3]) for x in range(width)])
+        previous = line
+    return width, height, rows
+
+
+def silhouette(rows):
+    return [[pixel != MAGENTA for pixel in row] for row in rows]
+
+
+def iou(a, b):
+    both = sum(x and y for ra, rb in zip(a, b) for x, y in zip(ra, rb))
+    either = sum(x or y for ra, rb in zip(a, b) for x, y in zip(ra, rb))
+    return both / either if either else 1.0
+
+
+def speckle(rows, mask):
+    """Fraction of object pixels that are speckles: isolated pixels of the silhouette (all 8
+    neighbours on the other side) plus interior pixels whose luminance differs by more than 0.2
+    from the median of their 3x3 neighbourhood (salt-and-pepper noise, not edges or shading)."""
+    height, width = len(rows), len(rows[0])
+    lum = [[(0.2126 * r + 0.7152 * g + 0.0722 * b) / 255.0 for (r, g, b) in row] for row in rows]
+    objects = speckles = 0
+    for y in range(1, height - 1):
+        for x in range(1, width - 1):
+            neighbours = [mask[y + dy][x + dx] for dy in (-1, 0, 1) for dx in (-1, 0, 1) if dy or dx]
+            if mask[y][x]:
+                objects += 1
+            if all(n != mask[y][x] for n in neighbours):
+                speckles += 1
+                continue
+            if mask[y][x] and all(neighbours):
+                window = sorted(lum[y + dy][x + dx] for dy in (-1, 0, 1) for dx in (-1, 0, 1))
+                if abs(lum[y][x] - window[4]) > 0.2:
+                    speckles += 1
+    return speckles / objects if objects else 0.0
+
+
+# ---------------------------------------------------------------- the three programs
+
+
+def povray_scene(path, max_iteration):
+    aspect = WIDTH / HEIGHT
+    horizontal = 2.0 * math.degrees(math.atan(math.tan(math.radians(FOV / 2)) * aspect))
+    lights = "\n".join(
+        f"light_source {{ <{d[0] * 1000}, {d[1] * 1000}, {d[2] * 1000}> color rgb <{c[0]}, {c[1]}, {c[2]}> }}"
+        for d, c in LIGHTS)
+    with open(path, "w") as scene:
+        scene.write(f"""#version 3.7;
+global_settings {{ assumed_gamma 1.0 }}
+// right-handed like dqjulia: the right vector is negated
+camera {{ perspective location <{EYE[0]}, {EYE[1]}, {EYE[2]}> look_at <{TARGET[0]}, {TARGET[1]}, {TARGET[2]}>
+         right -x*{aspect} up y angle {horizontal} }}
+background {{ rgb <1, 0, 1> }}
+{lights}
+julia_fractal {{ <{C[0]}, {C[1]}, {C[2]}, {C[3]}> quaternion sqr max_iteration {max_iteration} precision 20
+  pigment {{ rgb <0.85, 0.62, 0.35> }} finish {{ ambient 0.15 diffuse 0.8 specular 0.35 }} }}
+""")
+
+
+def dqjulia_params(path):
+    import json
+    params = {
+        "fractal": {"c": list(C) + [0, 0, 0, 0], "variant": "dual", "iterations": N, "bailout": bailout()},
+        "camera": {"position": list(EYE), "target": list(TARGET), "fov": FOV},
+        "render": {"width": WIDTH, "height": HEIGHT, "samples": 1, "background": [1, 0, 1]},
+    }
+    with open(path, "w") as out:
+        json.dump(params, out, indent=2)
+
+
+def mandelbulber_settings(path, resolution, output):
+    def number(x):  # Mandelbulber's settings files use a decimal comma
+        return repr(float(x)).replace(".", ",")
+    with open(path, "w") as settings:
+        settings.write(f"""# Mandelbulber settings file
+# version 2.20
+# only modified parameters
+[main_parameters]
+formula_1 5;
+julia_mode true;
+julia_c {number(C[0])} {number(C[1])} {number(C[2])};
+N {N};
+bailout {number(bailout())};
+voxel_custom_limit_enabled true;
+voxel_limit_min {number(-BOX)} {number(-BOX)} {number(-BOX)};
+voxel_limit_max {number(BOX)} {number(BOX)} {number(BOX)};
+voxel_samples_x {resolution};
+voxel_samples_y {resolution};
+voxel_samples_z {resolution};
+voxel_max_iter {N};
+mesh_output_filename {output};
+[fractal_1]
+""")
+
+
+def ply_summary(path):
+    """(vertices, faces) from a PLY header."""
+    vertices = faces = 0
+    with open(path, "rb") as ply:
+        for raw in ply:
+            line = raw.decode("ascii", "replace").strip()
+            if line.startswith("element vertex"):
+                vertices = int(line.split()[2])
+            elif line.startswith("element face"):
+                faces = int(line.split()[2])
+            elif line == "end_header":
+                break
+    return vertices, faces
+
+
+def ply_bounds(path):
+    """The bounding box of a binary little-endian PLY's vertices: ((min x, y, z), (max x, y, z))."""
+    codes = {"float": "f", "float32": "f", "double": "d", "float64": "d", "uchar": "B", "uint8": "B", "char": "b",
+             "int8": "b", "short": "h", "int16": "h", "ushort": "H", "uint16": "H", "int": "i", "int32": "i",
+             "uint": "I", "uint32": "I"}
+    with open(path, "rb") as ply:
+        properties, count, in_vertex = [], 0, False
+        while True:
+            line = ply.readline().decode("ascii", "replace").strip()
+            words = line.split()
+            if line.startswith("format") and words[1] != "binary_little_endian":
+                raise ValueError(f"{path}: only binary little-endian PLY is read here")
+            if words[:2] == ["element", "vertex"]:
+                count, in_vertex = int(words[2]), True
+            elif words and words[0] == "element":
+                in_vertex = False
+            elif words and words[0] == "property" and in_vertex:
+                properties.append((codes[words[1]], words[-1]))
+            elif line == "end_header":
+                break
+        layout = "<" + "".join(code for code, _ in properties)
+        size = struct.calcsize(layout)
+        x = [name for _, name in properties].index("x")
+        data = ply.read(size * count)
+    low, high = [math.inf] * 3, [-math.inf] * 3
+    for values in struct.iter_unpack(layout, data):
+        for axis in range(3):
+            v = values[x + axis]
+            low[axis], high[axis] = min(low[axis], v), max(high[axis], v)
+    return low, high
+
+
+def has_subcommand(dqjulia, name):
+    return subprocess.run([dqjulia, name, "--help"], capture_output=True).returncode == 0
+
+
+# ---------------------------------------------------------------- main
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    parser.add_argument("--build", default=os.path.join(root, "build-speed"), help="dqjulia build folder")
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--skip-mesh", action="store_true")
+    parser.add_argument("--skip-bake", action="store_true")
+    parser.add_argument("--skip-kernel", action="store_true")
+    parser.add_argument("--mesh-resolutions", default="256,512")
+    parser.add_argument("--bake-resolutions", default="256,512,1024")
+    parser.add_argument("--keep", help="keep the images and meshes in this folder")
+    args = parser.parse_args()
+
+    dqjulia = os.path.join(args.build, "bin", "dqjulia")
+    if not os.access(dqjulia, os.X_OK):
+        sys.exit(f"{dqjulia} not found: build first (cmake -S . -B {args.build} -DDQJ_BUILD_BENCH=ON && cmake --build {args.build} -j)")
+    work = args.keep or tempfile.mkdtemp(prefix="dqjulia_compare_")
+    os.makedirs(work, exist_ok=True)
+    params = os.path.join(work, "quaternion_julia.json")
+    dqjulia_params(params)
+    rows = []  # (measure, dqjulia, other, ratio text, target, met)
+    print(f"c = {C}, N = {N}, R = {bailout():.6f}, {WIDTH}x{HEIGHT}; working in {work}", flush=True)
+
+    # 1. Render against POV-Ray.
+    if ensure_installed("povray", "povray"):
+        scene = os.path.join(work, "julia.pov")
+        povray_scene(scene, N + 1)
+        ours_png = os.path.join(work, "dqjulia.png")
+        pov_png = os.path.join(work, "povray.png")
+        commands = {
+            "dqjulia": [dqjulia, "render", "-q", "-f", "-p", params, "-o", ours_png],
+            "povray": ["povray", f"+I{scene}", f"+O{pov_png}", f"+W{WIDTH}", f"+H{HEIGHT}", "-D", "-V", "+FN", "-GA"],
+        }
+        times = median_runs(commands, args.repeat, cwd=work)
+        _, _, ours_rows = read_png(ours_png)
+        _, _, pov_rows = read_png(pov_png)
+        ours_mask, pov_mask = silhouette(ours_rows), silhouette(pov_rows)
+        overlap = iou(ours_mask, pov_mask)
+        ours_speckle, pov_speckle = speckle(ours_rows, ours_mask), speckle(pov_rows, pov_mask)
+        wall_ratio = times["povray"]["wall"] / times["dqjulia"]["wall"]
+        cpu_ratio = times["povray"]["cpu"] / times["dqjulia"]["cpu"]
+        rows.append(("render 640x480 wall s", f"{times['dqjulia']['wall']:.3f}", f"POV-Ray {times['povray']['wall']:.3f}",
+                     f"{wall_ratio:.2f}x faster", ">= 5x", wall_ratio >= 5.0))
+        rows.append(("render 640x480 CPU s", f"{times['dqjulia']['cpu']:.3f}", f"POV-Ray {times['povray']['cpu']:.3f}",
+                     f"{cpu_ratio:.2f}x less CPU", "", None))
+        rows.append(("render silhouette IoU", f"{overlap:.4f}", "", "same object" if overlap > 0.9 else "DIFFERENT",
+                     "> 0.9", overlap > 0.9))
+        rows.append(("render speckle (object px)", f"{100 * ours_speckle:.3f}%", f"POV-Ray {100 * pov_speckle:.3f}%",
+                     "cleaner" if ours_speckle < pov_speckle else "NOT cleaner", "cleaner", ours_speckle < pov_speckle))
+
+    # 2. Mesh against Mandelbulber 2.
+    if not args.skip_mesh:
+        if not has_subcommand(dqjulia, "mesh"):
+            rows.append(("mesh", "pending", "", "dqjulia mesh is not built (bake issue)", "", None))
+        elif ensure_installed("mandelbulber2", "mandelbulber2"):
+            for resolution in [int(r) for r in args.mesh_resolutions.split(",")]:
+                ours_ply = os.path.join(work, f"dqjulia_{resolution}.ply")
+                mb_ply = os.path.join(work, f"mandelbulber_{resolution}.ply")
+                settings = os.path.join(work, f"mandelbulber_{resolution}.fract")
+                mandelbulber_settings(settings, resolution, mb_ply)
+                commands = {
+                    "dqjulia": [dqjulia, "mesh", "-q", "-f", "-p", params, "-r", str(resolution), "--bounds-min",
+                                str(-BOX), str(-BOX), str(-BOX), "--bounds-max", str(BOX), str(BOX), str(BOX), "-o", ours_ply],
+                    "mandelbulber2": ["mandelbulber2", "-n", "-V", "ply", settings],
+                }
+                times = median_runs(commands, 1 if resolution > 256 else args.repeat, cwd=work)
+                ratio = times["mandelbulber2"]["wall"] / times["dqjulia"]["wall"]
+                memory = times["mandelbulber2"]["peak_kb"] / times["dqjulia"]["peak_kb"]
+                target = resolution == 512
+                rows.append((f"mesh {resolution}^3 wall s", f"{times['dqjulia']['wall']:.2f}",
+                             f"Mandelbulber {times['mandelbulber2']['wall']:.2f}", f"{ratio:.1f}x faster",
+                             ">= 10x" if target else "", ratio >= 10.0 if target else None))
+                rows.append((f"mesh {resolution}^3 peak MB", f"{times['dqjulia']['peak_kb'] / 1024:.0f}",
+                             f"Mandelbulber {times['mandelbulber2']['peak_kb'] / 1024:.0f}", f"{memory:.2f}x less",
+                             "less" if target else "", memory > 1.0 if target else None))
+                ov, of = ply_summary(ours_ply)
+                mv, mf = ply_summary(mb_ply)
+                rows.append((f"mesh {resolution}^3 vertices/faces", f"{ov}/{of}", f"Mandelbulber {mv}/{mf}", "", "", None))
+                # Same object: the boxes of the two meshes, in voxels (Mandelbulber's surface is
+                # its DE = half a voxel, so it sits about a voxel further out).
+                voxel = 2 * BOX / resolution
+                (olow, ohigh), (mlow, mhigh) = ply_bounds(ours_ply), ply_bounds(mb_ply)
+                gap = max(max(abs(a - b) for a, b in zip(olow, mlow)), max(abs(a - b) for a, b in zip(ohigh, mhigh))) / voxel
+                rows.append((f"mesh {resolution}^3 bounding boxes", "", "", f"differ by {gap:.1f} voxels",
+                             "same object", gap < 0.02 * resolution))
+
+    # 3. Bake growth.
+    if not args.skip_bake:
+        if not has_subcommand(dqjulia, "bake"):
+            rows.append(("bake", "pending", "", "dqjulia bake is not built (bake issue)", "", None))
+        else:
+            points = []
+            for resolution in [int(r) for r in args.bake_resolutions.split(",")]:
+                vdb = os.path.join(work, f"bake_{resolution}.vdb")
+                command = [dqjulia, "bake", "-q", "-f", "-p", params, "-r", str(resolution), "--bounds-min", str(-BOX),
+                           str(-BOX), str(-BOX), "--bounds-max", str(BOX), str(BOX), str(BOX), "-o", vdb]
+                result = median_runs({"bake": command}, 1, cwd=work)["bake"]
+                points.append((resolution, result["wall"], result["cpu"], result["peak_kb"]))
+                rows.append((f"bake {resolution}^3", f"{result['wall']:.2f} s", f"{result['peak_kb'] / 1024:.0f} MB peak",
+                             f"CPU {result['cpu']:.2f} s", "", None))
+                if os.path.exists(vdb) and not args.keep:
+                    os.remove(vdb)
+            if len(points) >= 2:
+                xs = [math.log(p[0]) for p in points]
+                for label, index in (("wall", 1), ("CPU", 2)):
+                    ys = [math.log(max(p[index], 1e-6)) for p in points]
+                    mx, my = statistics.mean(xs), statistics.mean(ys)
+                    slope = sum((x - mx) * (y - my) for x, y in zip(xs, ys)) / sum((x - mx) ** 2 for x in xs)
+                    rows.append((f"bake growth exponent ({label})", f"{slope:.2f}", "", "time ~ resolution^k",
+                                 "<= 2.3" if label == "CPU" else "", slope <= 2.3 if label == "CPU" else None))
+
+    # 4. The kernel benchmark (same run).
+    bench = os.path.join(args.build, "bin", "dqjulia_bench")
+    if not args.skip_kernel and os.access(bench, os.X_OK):
+        result = subprocess.run([bench, "--benchmark_min_time=0.3"], capture_output=True, text=True)
+        summary = result.stdout[result.stdout.find("Summary"):]
+        print(summary, flush=True)
+        for line in summary.splitlines():
+            parts = line.split()
+            if parts and parts[0] in ("paper", "paper-coupled", "dual") and len(parts) >= 7:
+                double_ratio, float_ratio = float(parts[3]), float(parts[5])
+                rows.append((f"kernel {parts[0]} SIMD/scalar", f"double {double_ratio:.2f}x", f"float {float_ratio:.2f}x",
+                             "", ">= 4x", max(double_ratio, float_ratio) >= 4.0))
+
+    width = [max(len(str(row[i])) for row in rows + [("measure", "dqjulia", "other", "ratio", "target", "")]) for i in range(5)]
+    print()
+    header = ("measure", "dqjulia", "other", "ratio", "target", "met")
+    print("  ".join(str(h).ljust(w) for h, w in zip(header, width + [3])))
+    for row in rows:
+        met = "" if row[5] is None else ("yes" if row[5] else "NO")
+        print("  ".join(str(c).ljust(w) for c, w in zip(row[:5], width)) + "  " + met)
+    print(f"\n(same run; medians of {args.repeat} interleaved runs where repeated; outputs in {work})")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,73 @@
+"""dqjulia for Blender: dual-quaternion Julia fractals as a live viewport preview, baked
+OpenVDB volumes and meshes, and an OSL volume, all computed by the dqjulia core library.
+
+Layout (one idea a module): native.py (ctypes bindings of the C ABI), props.py (the
+parameters on the object and the parameter file's JSON), slicing.py (the slice's 8-D axes),
+animation.py (keyframes), preview.py (the GLSL preview), jobs.py (work in a thread),
+bakes.py (cache folder, objects from bakes), operators.py, panels.py, osl.py, shaders/.
+"""
+
+bl_info = {
+    "name": "DQ Julia",
+    "author": "dqjulia",
+    "version": (0, 1, 0),
+    "blender": (3, 4, 0),
+    "location": "View3D > Add > DQ Julia; View3D > Sidebar > DQ Julia; Properties > Object",
+    "description": "Dual-quaternion Julia fractals: GLSL preview, OpenVDB volume and mesh bakes, OSL volume",
+    "category": "Add Mesh",
+    "doc_url": "",
+}
+
+import bpy
+from bpy.props import StringProperty
+
+from . import bakes, jobs, native, operators, osl, panels, preview, props
+
+
+class DQJuliaPreferences(bpy.types.AddonPreferences):
+    bl_idname = __package__
+
+    cache_dir: StringProperty(
+        name="Cache folder", subtype="DIR_PATH", default="",
+        description="Where bakes are written (VDB files). Empty: Blender's user data folder, never the add-on's")
+
+    def draw(self, context):
+        layout = self.layout
+        layout.prop(self, "cache_dir")
+        try:
+            layout.label(text="Bakes go to: %s" % bakes.cache_root(context))
+        except ValueError as error:
+            layout.label(text=str(error), icon="ERROR")
+        error = native.load_error()
+        if error is None:
+            layout.label(text="Library: dqjulia %s (%s)" % (native.version()[1], native.library_path()),
+                         icon="CHECKMARK")
+        else:
+            box = layout.box()
+            box.alert = True
+            for line in panels.textwrap.wrap(error, 90):
+                box.label(text=line)
+        if not osl.available():
+            layout.label(text="This Blender has no OSL: the OSL volume is unavailable (bakes and preview work).",
+                         icon="INFO")
+
+
+def register():
+    bpy.utils.register_class(DQJuliaPreferences)
+    props.register()
+    operators.register()
+    panels.register()
+    osl.register()
+    preview.register()
+
+
+def unregister():
+    jobs.cancel_all()
+    for job in jobs.active_jobs():
+        job.join(5.0)
+    preview.unregister()
+    osl.unregister()
+    panels.unregister()
+    operators.unregister()
+    props.unregister()
+    bpy.utils.unregister_class(DQJuliaPreferences)

@@ -1,0 +1,246 @@
+"""Where bakes go, and the Blender objects made from them (main thread only).
+
+Files go to a cache folder outside the add-on's own folder: the preferences' cache folder if
+set, else Blender's user data folder (4.2+: the extension's user folder). Each bake writes
+new file names and deletes the files of the bake it replaces, so Blender's volume cache never
+shows stale grids. Objects are built only from a finished bake; if building fails, whatever
+was made is removed again, so no half-made object remains.
+"""
+
+import array
+import os
+import shutil
+import uuid
+
+import bpy
+
+ADDON_DIR = os.path.dirname(os.path.abspath(__file__))
+BAKE_KIND = "dqjulia_bake"      # custom property on baked objects: "volume", "mesh", "sequence"
+BAKE_FILES = "dqjulia_files"    # custom property: the files or folder the baked object reads
+VOLUME_DENSITY_SCALE = 10.0     # the fog is 0..1; this makes the set read as solid-ish smoke
+
+
+def _package():
+    return __package__ or "dqjulia"
+
+
+def preferences(context=None):
+    context = context or bpy.context
+    addon = context.preferences.addons.get(_package())
+    return addon.preferences if addon else None
+
+
+def default_cache_root():
+    """The default cache folder: never inside the add-on's folder."""
+    extension_path_user = getattr(bpy.utils, "extension_path_user", None)
+    if extension_path_user is not None:
+        try:
+            return extension_path_user(_package(), path="cache", create=True)
+        except (ValueError, RuntimeError, TypeError):
+            pass  # a legacy add-on in 4.2+, not an extension
+    return bpy.utils.user_resource("DATAFILES", path="dqjulia_cache", create=True)
+
+
+def cache_root(context=None):
+    prefs = preferences(context)
+    chosen = getattr(prefs, "cache_dir", "") if prefs else ""
+    root = bpy.path.abspath(chosen) if chosen else default_cache_root()
+    root = os.path.abspath(root)
+    if os.path.commonpath([root, ADDON_DIR]) == ADDON_DIR:
+        raise ValueError("the cache folder %s is inside the add-on's folder, which Blender replaces on updates; "
+                         "choose another in the add-on's preferences" % root)
+    return root
+
+
+def _safe(name):
+    return "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in name) or "object"
+
+
+def object_cache_dir(obj, context=None):
+    blend = bpy.data.filepath
+    project = os.path.splitext(os.path.basename(blend))[0] if blend else "untitled"
+    return os.path.join(cache_root(context), _safe(project), _safe(obj.name))
+
+
+def new_volume_path(obj, context=None):
+    return os.path.join(object_cache_dir(obj, context), "%s_volume_%s.vdb" % (_safe(obj.name), uuid.uuid4().hex[:8]))
+
+
+def new_sequence_dir(obj, context=None):
+    return os.path.join(object_cache_dir(obj, context), "%s_sequence_%s" % (_safe(obj.name), uuid.uuid4().hex[:8]))
+
+
+def sequence_frame_path(directory, obj, frame):
+    """name_0001.vdb: the numbered files Blender plays back as a volume sequence."""
+    return os.path.join(directory, "%s_%04d.vdb" % (_safe(obj.name), frame))
+
+
+def remove_files(paths):
+    for path in paths:
+        try:
+            if os.path.isdir(path):
+                shutil.rmtree(path)
+            elif os.path.exists(path):
+                os.remove(path)
+        except OSError:
+            pass
+
+
+# -------------------------------------------------------------------------------------------
+# Objects
+
+
+def _find_baked(source, kind):
+    for child in source.children:
+        if child.get(BAKE_KIND) == kind:
+            return child
+    return None
+
+
+def _link(context, source, obj):
+    collections = source.users_collection or (context.scene.collection,)
+    collections[0].objects.link(obj)
+    obj.parent = source
+    obj.matrix_parent_inverse.identity()
+    obj.matrix_basis.identity()  # the bake is in the slice's (= the source's local) coordinates
+
+
+def _replace(context, source, kind, name, data, files):
+    """Puts `data` into the source's baked object of this kind (made if missing); returns it and
+    removes the files of the bake it replaces."""
+    obj = _find_baked(source, kind)
+    old_files = []
+    if obj is None:
+        obj = bpy.data.objects.new(name, data)
+        _link(context, source, obj)
+    else:
+        old_data = obj.data
+        old_files = list(obj.get(BAKE_FILES, []))
+        obj.data = data
+        if old_data is not None and old_data.users == 0:
+            if isinstance(old_data, bpy.types.Volume):
+                bpy.data.volumes.remove(old_data)
+            elif isinstance(old_data, bpy.types.Mesh):
+                bpy.data.meshes.remove(old_data)
+    obj[BAKE_KIND] = kind
+    obj[BAKE_FILES] = list(files)
+    remove_files([path for path in old_files if path not in files])
+    return obj
+
+
+def volume_material(name, grid_names):
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    tree = material.node_tree
+    tree.nodes.clear()
+    output = tree.nodes.new("ShaderNodeOutputMaterial")
+    output.location = (300, 0)
+    volume = tree.nodes.new("ShaderNodeVolumePrincipled")
+    volume.location = (0, 0)
+    volume.inputs["Density"].default_value = VOLUME_DENSITY_SCALE
+    if "Density Attribute" in volume.inputs:
+        volume.inputs["Density Attribute"].default_value = "density"
+    if "color" in grid_names:
+        if "Color Attribute" in volume.inputs:
+            volume.inputs["Color Attribute"].default_value = "color"
+        attribute = tree.nodes.new("ShaderNodeAttribute")
+        attribute.attribute_name = "color"
+        attribute.location = (-250, 100)
+        tree.links.new(attribute.outputs["Color"], volume.inputs["Color"])
+    tree.links.new(volume.outputs["Volume"], output.inputs["Volume"])
+    return material
+
+
+def grid_names(path):
+    """The grids Blender reads from a VDB file; RuntimeError if it cannot read it."""
+    probe = bpy.data.volumes.new("dqjulia probe")
+    try:
+        probe.filepath = path
+        if not probe.grids.load():
+            raise RuntimeError("Blender could not read %s: %s" % (path, probe.grids.error_message or "unknown error"))
+        return [grid.name for grid in probe.grids]
+    finally:
+        bpy.data.volumes.remove(probe)
+
+
+def build_volume(context, source, path, sequence=None):
+    """A Volume object reading `path` (the first file of a sequence when `sequence` is
+    (first frame, frame count, folder)); raises RuntimeError, leaving nothing, if Blender
+    cannot read the file or it lacks the "density" grid."""
+    kind = "sequence" if sequence else "volume"
+    name = "%s %s" % (source.name, "Volume Sequence" if sequence else "Volume")
+    names = grid_names(path)
+    if "density" not in names:
+        raise RuntimeError("%s has no \"density\" grid (grids: %s)" % (path, ", ".join(names) or "none"))
+    volume = bpy.data.volumes.new(name)
+    material = None
+    try:
+        volume.filepath = path
+        if sequence:
+            # Blender plays file number (scene frame - frame_start + 1 + frame_offset): with the
+            # offset below, file name_0007.vdb is scene frame 7.
+            first, count, _folder = sequence
+            volume.is_sequence = True
+            volume.frame_start = first
+            volume.frame_duration = count
+            volume.frame_offset = first - 1
+            volume.sequence_mode = "CLIP"
+        material = volume_material(name, names)
+        volume.materials.append(material)
+        files = [sequence[2]] if sequence else [path]
+        return _replace(context, source, kind, name, volume, files)
+    except Exception:
+        if material is not None:
+            bpy.data.materials.remove(material)
+        bpy.data.volumes.remove(volume)
+        raise
+
+
+def mesh_material(name, with_colors):
+    material = bpy.data.materials.new(name)
+    material.use_nodes = True
+    tree = material.node_tree
+    bsdf = next((node for node in tree.nodes if node.type == "BSDF_PRINCIPLED"), None)
+    if bsdf is not None and with_colors:
+        attribute = tree.nodes.new("ShaderNodeAttribute")
+        attribute.attribute_name = "Col"
+        attribute.location = (-300, 200)
+        tree.links.new(attribute.outputs["Color"], bsdf.inputs["Base Color"])
+    return material
+
+
+def build_mesh(context, source, data):
+    """A mesh object from MeshData, filled with foreach_set (no per-vertex Python calls),
+    with the core's normals as custom split normals and its colours as a colour attribute."""
+    name = "%s Mesh" % source.name
+    mesh = bpy.data.meshes.new(name)
+    material = None
+    try:
+        vertices, triangles = data.vertex_count, data.triangle_count
+        mesh.vertices.add(vertices)
+        mesh.vertices.foreach_set("co", data.positions)
+        mesh.loops.add(3 * triangles)
+        mesh.loops.foreach_set("vertex_index", data.triangles)
+        mesh.polygons.add(triangles)
+        mesh.polygons.foreach_set("loop_start", array.array("i", range(0, 3 * triangles, 3)))
+        mesh.polygons.foreach_set("loop_total", array.array("i", [3]) * triangles)
+        mesh.polygons.foreach_set("use_smooth", array.array("b", [1]) * triangles)
+        mesh.update(calc_edges=True)
+        if hasattr(mesh, "use_auto_smooth"):  # Blender < 4.1: custom normals need auto smooth
+            mesh.use_auto_smooth = True
+        normals = data.normals
+        mesh.normals_split_custom_set_from_vertices([normals[i:i + 3] for i in range(0, len(normals), 3)])
+        if data.colors is not None and vertices:
+            rgba = array.array("f", [1.0]) * (4 * vertices)
+            for channel in range(3):
+                rgba[channel::4] = data.colors[channel::3]
+            attribute = mesh.color_attributes.new("Col", "FLOAT_COLOR", "POINT")
+            attribute.data.foreach_set("color", rgba)
+        material = mesh_material(name, data.colors is not None)
+        mesh.materials.append(material)
+        return _replace(context, source, "mesh", name, mesh, [])
+    except Exception:
+        if material is not None:
+            bpy.data.materials.remove(material)
+        bpy.data.meshes.remove(mesh)
+        raise

@@ -1,0 +1,210 @@
+"""Background work: bakes run in a worker thread, never on Blender's main thread.
+
+A Job is a list of tasks (one native call each: a VDB bake, a mesh) run one after another
+in a thread. ctypes releases the GIL for the whole native call, so Blender stays responsive;
+the core reports progress through a ctypes callback (native.Progress), which records the
+fraction and returns 1 once cancel() was asked, and the call then ends with
+DQJ_ERROR_CANCELLED. Nothing here touches bpy: the worker only fills plain Python objects,
+and the operator that owns the job (operators.py) polls it from a modal timer on the main
+thread, shows its progress, and builds Blender objects only when it has succeeded.
+"""
+
+import array
+import os
+import threading
+import time
+
+from . import native
+
+_active = []          # running jobs, for the panels
+_lock = threading.Lock()
+
+
+class MeshData:
+    """A mesh copied out of the core: flat arrays ready for foreach_set (no bpy)."""
+
+    def __init__(self, positions, normals, colors, triangles):
+        self.positions = positions    # array('f'), 3 a vertex
+        self.normals = normals        # array('f'), 3 a vertex
+        self.colors = colors          # array('f'), 3 a vertex, or None
+        self.triangles = triangles    # array('i'), 3 a triangle
+
+    @property
+    def vertex_count(self):
+        return len(self.positions) // 3
+
+    @property
+    def triangle_count(self):
+        return len(self.triangles) // 3
+
+
+def _as_array(typecode, ctypes_array):
+    result = array.array(typecode)
+    result.frombytes(memoryview(ctypes_array).cast("B"))
+    return result
+
+
+class VolumeTask:
+    """Bakes one document to a VDB file (grids "surface" and "density" at least)."""
+
+    kind = "volume"
+
+    def __init__(self, document, path, frame=None):
+        self.document = document
+        self.path = path
+        self.frame = frame
+        self.warning = ""
+
+    def run(self, context, progress):
+        directory = os.path.dirname(self.path)
+        if directory:
+            os.makedirs(directory, exist_ok=True)
+        self.warning = context.bake_vdb(self.path, progress)
+        return self.path
+
+
+class MeshTask:
+    """Meshes one document's surface and copies the mesh out of the core."""
+
+    kind = "mesh"
+
+    def __init__(self, document, colors=True):
+        self.document = document
+        self.colors = colors
+        self.warning = ""
+
+    def run(self, context, progress):
+        self.warning = context.mesh_compute(progress)
+        positions, normals, colors, triangles = context.mesh_copy(colors=self.colors)
+        return MeshData(_as_array("f", positions), _as_array("f", normals),
+                        _as_array("f", colors) if colors is not None else None,
+                        _as_array("i", triangles))
+
+
+class Job:
+    """Tasks run in order in one worker thread (or synchronously with run())."""
+
+    RUNNING, DONE, FAILED, CANCELLED = "running", "done", "failed", "cancelled"
+
+    def __init__(self, label, tasks, owner=""):
+        self.label = label
+        self.owner = owner            # the object's name, for the panel
+        self.tasks = list(tasks)
+        self.results = []
+        self.state = Job.RUNNING
+        self.error = ""
+        self.warnings = []
+        self.index = 0                # the task under way
+        self._task_fraction = 0.0
+        self._progress = None
+        self._cancel = threading.Event()
+        self._thread = None
+        self.started = time.monotonic()
+        self.finished = None
+
+    # progress ------------------------------------------------------------------------------
+
+    @property
+    def fraction(self):
+        if not self.tasks:
+            return 1.0
+        return min(1.0, (self.index + self._task_fraction) / len(self.tasks))
+
+    def _on_progress(self, fraction):
+        self._task_fraction = fraction
+
+    def status_text(self):
+        part = " %d/%d" % (self.index + 1, len(self.tasks)) if len(self.tasks) > 1 else ""
+        return "%s%s: %d%%" % (self.label, part, round(100.0 * self.fraction))
+
+    # control -------------------------------------------------------------------------------
+
+    def cancel(self):
+        """Asks the work to stop; safe from any thread. The native call returns at its next
+        progress report."""
+        self._cancel.set()
+        progress = self._progress
+        if progress is not None:
+            progress.cancel()
+
+    @property
+    def cancel_requested(self):
+        return self._cancel.is_set()
+
+    @property
+    def finished_running(self):
+        return self.state != Job.RUNNING
+
+    def run(self):
+        """Runs every task in the calling thread (the worker, or the main thread for scripts)."""
+        try:
+            context = native.Context()
+            try:
+                for index, task in enumerate(self.tasks):
+                    self.index = index
+                    self._task_fraction = 0.0
+                    if self._cancel.is_set():
+                        raise native.NativeError(native.ERROR_CANCELLED, "cancelled")
+                    progress = native.Progress(self._on_progress)
+                    self._progress = progress
+                    if self._cancel.is_set():
+                        progress.cancel()
+                    context.set_params(task.document)  # a frame's values: no keyframes in it
+                    self.results.append(task.run(context, progress))
+                    if task.warning:
+                        self.warnings.append(task.warning)
+                    self._task_fraction = 1.0
+                self.index = len(self.tasks)
+                self._task_fraction = 0.0
+                self.state = Job.DONE
+            finally:
+                self._progress = None
+                context.close()
+        except native.NativeError as error:
+            if error.cancelled or self._cancel.is_set():
+                self.state = Job.CANCELLED
+                self.error = "cancelled"
+            else:
+                self.state = Job.FAILED
+                self.error = error.message
+        except native.NativeUnavailable as error:
+            self.state = Job.FAILED
+            self.error = str(error)
+        except OSError as error:  # e.g. the cache folder cannot be made
+            self.state = Job.FAILED
+            self.error = str(error)
+        except Exception as error:  # report anything else rather than lose it in a thread
+            self.state = Job.FAILED
+            self.error = "%s: %s" % (type(error).__name__, error)
+        finally:
+            self.finished = time.monotonic()
+        return self.state
+
+    def start(self):
+        """Runs the tasks in a worker thread; poll finished_running from the main thread."""
+        with _lock:
+            _active.append(self)
+        self._thread = threading.Thread(target=self._thread_main, name="dqjulia-" + self.label, daemon=True)
+        self._thread.start()
+
+    def _thread_main(self):
+        try:
+            self.run()
+        finally:
+            with _lock:
+                if self in _active:
+                    _active.remove(self)
+
+    def join(self, timeout=None):
+        if self._thread is not None:
+            self._thread.join(timeout)
+
+
+def active_jobs(owner=None):
+    with _lock:
+        return [job for job in _active if owner is None or job.owner == owner]
+
+
+def cancel_all():
+    for job in active_jobs():
+        job.cancel()

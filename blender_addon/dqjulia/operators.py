@@ -1,0 +1,510 @@
+"""Operators: add a DQ Julia object, presets, import/export of parameter files, the bakes
+(volume, mesh, sequence) and the OSL volume.
+
+Bakes are modal: the work runs in a worker thread (jobs.py), a window-manager timer polls it,
+the cursor and the status bar show progress, Esc cancels. Scripts and tests get the same work
+synchronously with `synchronous=True` (automatic in background mode, where there are no
+events); the objects are built the same way in both paths.
+"""
+
+import os
+import tempfile
+
+import bpy
+from bpy.props import BoolProperty, EnumProperty, StringProperty
+from bpy_extras.io_utils import ExportHelper, ImportHelper
+
+from . import animation, bakes, jobs, native, osl, preview, props
+
+PRESET_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "presets")
+
+
+def dqjulia_object(context):
+    obj = getattr(context, "object", None) or getattr(context, "active_object", None)
+    if obj is not None and getattr(obj, "dqjulia", None) is not None and obj.dqjulia.enabled:
+        return obj
+    return None
+
+
+def preset_names():
+    if not os.path.isdir(PRESET_DIR):
+        return []
+    return sorted(os.path.splitext(name)[0] for name in os.listdir(PRESET_DIR) if name.endswith(".json"))
+
+
+def _preset_items(_self, _context):
+    return [(name, name, "examples/%s.json" % name) for name in preset_names()] or [("", "(no presets)", "")]
+
+
+def load_params_into(obj, path):
+    """Reads a parameter file through the core (which validates it) into the object's
+    properties, keyframes included. Raises native.NativeError with the core's message."""
+    with native.Context() as context:
+        context.load_params_file(path)
+        document = context.params()
+    props.from_document(obj.dqjulia, document)
+    animation.apply_section(obj, document.get("animation") or {})
+    return document
+
+
+def document_for_file(obj):
+    """The object's complete document, keyframes included, as the core writes it (validated);
+    and the names of animated properties the file cannot hold."""
+    section, skipped = animation.animation_section(obj)
+    document = props.to_document(obj.dqjulia, with_animation=section)
+    with native.Context() as context:
+        context.set_params(document)
+        return context.params_json(), skipped
+
+
+def write_text_atomically(path, text):
+    directory = os.path.dirname(os.path.abspath(path))
+    os.makedirs(directory, exist_ok=True)
+    handle, temporary = tempfile.mkstemp(prefix=".dqjulia-", suffix=".json", dir=directory)
+    try:
+        with os.fdopen(handle, "w", encoding="utf-8") as file:
+            file.write(text)
+        os.replace(temporary, path)
+    except BaseException:
+        if os.path.exists(temporary):
+            os.remove(temporary)
+        raise
+
+
+def _library_ready(operator):
+    error = native.load_error()
+    if error is not None:
+        operator.report({"ERROR"}, error)
+        return False
+    return True
+
+
+class DQJULIA_OT_add(bpy.types.Operator):
+    """Add a DQ Julia object: the set ray-marched in the viewport inside its bounds"""
+    bl_idname = "object.dqjulia_add"
+    bl_label = "DQ Julia"
+    bl_options = {"REGISTER", "UNDO"}
+
+    preset: StringProperty(name="Preset", default="", description="A preset name or a parameter file to start from")
+
+    def execute(self, context):
+        if not _library_ready(self):
+            return {"CANCELLED"}
+        if context.mode != "OBJECT" and bpy.ops.object.mode_set.poll():
+            bpy.ops.object.mode_set(mode="OBJECT")
+        obj = bpy.data.objects.new("DQ Julia", None)
+        obj.empty_display_type = "SPHERE"
+        obj.location = context.scene.cursor.location
+        context.collection.objects.link(obj)
+        try:
+            obj.dqjulia.enabled = True
+            if self.preset:
+                path = self.preset if os.path.isfile(self.preset) else os.path.join(PRESET_DIR, self.preset + ".json")
+                load_params_into(obj, path)
+            else:
+                with native.Context() as native_context:  # the core's defaults, so they never drift
+                    props.from_document(obj.dqjulia, native_context.params())
+        except (native.NativeError, native.NativeUnavailable, OSError) as error:
+            bpy.data.objects.remove(obj)
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        state = preview.state_for(obj)
+        if state.bounds is not None:
+            obj.empty_display_size = state.bounds[1]
+        for other in context.selected_objects:
+            other.select_set(False)
+        obj.select_set(True)
+        context.view_layer.objects.active = obj
+        return {"FINISHED"}
+
+
+class DQJULIA_OT_load_preset(bpy.types.Operator):
+    """Load one of the example parameter files into the active DQ Julia object"""
+    bl_idname = "dqjulia.load_preset"
+    bl_label = "Load Preset"
+    bl_options = {"REGISTER", "UNDO"}
+
+    preset: EnumProperty(name="Preset", items=_preset_items)
+
+    @classmethod
+    def poll(cls, context):
+        return dqjulia_object(context) is not None
+
+    def execute(self, context):
+        if not _library_ready(self):
+            return {"CANCELLED"}
+        obj = dqjulia_object(context)
+        try:
+            load_params_into(obj, os.path.join(PRESET_DIR, self.preset + ".json"))
+        except (native.NativeError, OSError) as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        self.report({"INFO"}, "Loaded preset %s" % self.preset)
+        return {"FINISHED"}
+
+
+class DQJULIA_OT_import_params(bpy.types.Operator, ImportHelper):
+    """Read a dqjulia parameter file (the JSON the command-line tool reads) into the active DQ Julia object"""
+    bl_idname = "dqjulia.import_params"
+    bl_label = "Import Parameters"
+    bl_options = {"REGISTER", "UNDO"}
+
+    filename_ext = ".json"
+    filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
+
+    @classmethod
+    def poll(cls, context):
+        return dqjulia_object(context) is not None
+
+    def execute(self, context):
+        if not _library_ready(self):
+            return {"CANCELLED"}
+        try:
+            load_params_into(dqjulia_object(context), self.filepath)
+        except (native.NativeError, OSError) as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        self.report({"INFO"}, "Read %s" % self.filepath)
+        return {"FINISHED"}
+
+
+class DQJULIA_OT_export_params(bpy.types.Operator, ExportHelper):
+    """Write the active DQ Julia object's parameters (and keyframes) as a dqjulia parameter file"""
+    bl_idname = "dqjulia.export_params"
+    bl_label = "Export Parameters"
+
+    filename_ext = ".json"
+    filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
+
+    @classmethod
+    def poll(cls, context):
+        return dqjulia_object(context) is not None
+
+    def execute(self, context):
+        if not _library_ready(self):
+            return {"CANCELLED"}
+        try:
+            text, skipped = document_for_file(dqjulia_object(context))
+            write_text_atomically(self.filepath, text)
+        except (native.NativeError, OSError) as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        if skipped:
+            self.report({"WARNING"}, "Wrote %s; the file cannot hold the keyframes of %s (it animates the constant, "
+                        "iterations, bailout and rotation angles)" % (self.filepath, ", ".join(skipped)))
+        else:
+            self.report({"INFO"}, "Wrote %s" % self.filepath)
+        return {"FINISHED"}
+
+
+class DQJULIA_OT_collection_edit(bpy.types.Operator):
+    """Add or remove an entry of a list (rotations, lights, palette)"""
+    bl_idname = "dqjulia.collection_edit"
+    bl_label = "Edit List"
+    bl_options = {"REGISTER", "UNDO", "INTERNAL"}
+
+    collection: EnumProperty(items=[("rotations", "Rotations", ""), ("lights", "Lights", ""),
+                                    ("palette", "Palette", "")])
+    action: EnumProperty(items=[("ADD", "Add", ""), ("REMOVE", "Remove", "")])
+    index: bpy.props.IntProperty(default=-1)
+
+    @classmethod
+    def poll(cls, context):
+        return dqjulia_object(context) is not None
+
+    def execute(self, context):
+        settings = dqjulia_object(context).dqjulia
+        items = getattr(settings, self.collection)
+        if self.action == "ADD":
+            item = items.add()
+            if self.collection == "rotations":
+                item.degrees = 30.0
+                settings.active_rotation = len(items) - 1
+        else:
+            index = self.index if self.index >= 0 else len(items) - 1
+            if 0 <= index < len(items):
+                items.remove(index)
+            settings.active_rotation = max(0, min(settings.active_rotation, len(items) - 1))
+        props._redraw(None, context)
+        return {"FINISHED"}
+
+
+# -------------------------------------------------------------------------------------------
+# Bakes
+
+
+class _BakeOperator:
+    """Shared by the bake operators: start the job, poll it, conclude on the main thread."""
+
+    bl_options = {"REGISTER", "UNDO"}
+
+    synchronous: BoolProperty(name="Synchronous", default=False, options={"SKIP_SAVE", "HIDDEN"},
+                              description="Bake in the calling thread and return when done (scripts, tests)")
+
+    _job = None
+    _timer = None
+    _source_name = ""
+    _cleanup = ()
+
+    @classmethod
+    def poll(cls, context):
+        return dqjulia_object(context) is not None and not jobs.active_jobs(dqjulia_object(context).name)
+
+    # to override ------------------------------------------------------------------------
+    def make_job(self, context, obj):
+        raise NotImplementedError
+
+    def build(self, context, obj, job):
+        raise NotImplementedError
+
+    # -------------------------------------------------------------------------------------
+    def _check_document(self, document):
+        with native.Context() as context:
+            context.set_params(document)
+
+    def execute(self, context):
+        if not _library_ready(self):
+            return {"CANCELLED"}
+        if not native.has("dqj_bake_vdb"):
+            self.report({"ERROR"}, "the dqjulia library %s cannot bake (no dqj_bake_vdb): install the add-on zip "
+                                   "from a build with OpenVDB baking" % native.version()[1])
+            return {"CANCELLED"}
+        obj = dqjulia_object(context)
+        try:
+            job = self.make_job(context, obj)
+        except (native.NativeError, ValueError, OSError) as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        self._job = job
+        self._source_name = obj.name
+        if self.synchronous or bpy.app.background or context.window is None:
+            job.run()
+            return self._conclude(context)
+        job.start()
+        wm = context.window_manager
+        wm.progress_begin(0, 100)
+        self._timer = wm.event_timer_add(0.1, window=context.window)
+        wm.modal_handler_add(self)
+        self._status(context, job.status_text() + " (Esc to cancel)")
+        return {"RUNNING_MODAL"}
+
+    def invoke(self, context, _event):
+        return self.execute(context)
+
+    def modal(self, context, event):
+        job = self._job
+        if event.type == "ESC" and event.value == "PRESS":
+            job.cancel()
+            self._status(context, "%s: cancelling..." % job.label)
+            return {"RUNNING_MODAL"}
+        if event.type == "TIMER":
+            context.window_manager.progress_update(int(100 * job.fraction))
+            if job.cancel_requested:
+                self._status(context, "%s: cancelling..." % job.label)
+            else:
+                self._status(context, job.status_text() + " (Esc to cancel)")
+            _redraw_progress(context)
+            if job.finished_running:
+                job.join()
+                self._stop(context)
+                return self._conclude(context)
+        return {"PASS_THROUGH"}
+
+    def cancel(self, context):
+        # Blender is closing the operator (e.g. the file is being closed): stop the work.
+        if self._job is not None:
+            self._job.cancel()
+            self._job.join()
+            bakes.remove_files(self._cleanup)
+        self._stop(context)
+
+    def _stop(self, context):
+        wm = context.window_manager
+        if self._timer is not None:
+            wm.event_timer_remove(self._timer)
+            self._timer = None
+        wm.progress_end()
+        self._status(context, None)
+
+    @staticmethod
+    def _status(context, text):
+        workspace = getattr(context, "workspace", None)
+        if workspace is not None:
+            workspace.status_text_set(text)
+
+    def _conclude(self, context):
+        job = self._job
+        obj = bpy.data.objects.get(self._source_name)
+        if job.state == jobs.Job.DONE and obj is None:
+            job.state, job.error = jobs.Job.FAILED, "the object %s was deleted during the bake" % self._source_name
+        if job.state == jobs.Job.DONE:
+            try:
+                message = self.build(context, obj, job)
+            except Exception as error:
+                bakes.remove_files(self._cleanup)
+                self.report({"ERROR"}, "%s failed: %s" % (job.label, error))
+                return {"CANCELLED"}
+            for warning in dict.fromkeys(job.warnings):
+                self.report({"WARNING"}, warning)
+            self.report({"INFO"}, "%s (%.1f s)" % (message, job.finished - job.started))
+            return {"FINISHED"}
+        bakes.remove_files(self._cleanup)
+        if job.state == jobs.Job.CANCELLED:
+            self.report({"WARNING"}, "%s cancelled; nothing was added" % job.label)
+        else:
+            self.report({"ERROR"}, "%s failed: %s" % (job.label, job.error))
+        return {"CANCELLED"}
+
+
+def _redraw_progress(context):
+    """Redraw where the progress text is (the sidebar and the properties), not the 3-D view
+    itself: its preview is the expensive part of a redraw."""
+    for area in context.screen.areas if context.screen else ():
+        if area.type == "PROPERTIES":
+            area.tag_redraw()
+        elif area.type == "VIEW_3D":
+            for region in area.regions:
+                if region.type == "UI":
+                    region.tag_redraw()
+
+
+def _bake_document(obj, need_density=False):
+    document = props.to_document(obj.dqjulia)
+    if need_density and "density" not in document["bake"]["grids"]:
+        document["bake"]["grids"].append("density")  # Blender renders the "density" grid
+    return document
+
+
+class DQJULIA_OT_bake_volume(_BakeOperator, bpy.types.Operator):
+    """Bake the set at this frame to an OpenVDB file and add a Volume object that renders it"""
+    bl_idname = "dqjulia.bake_volume"
+    bl_label = "Bake Volume"
+
+    def make_job(self, context, obj):
+        document = _bake_document(obj, need_density=True)
+        self._check_document(document)
+        path = bakes.new_volume_path(obj, context)
+        self._cleanup = (path,)
+        return jobs.Job("Bake volume", [jobs.VolumeTask(document, path)], owner=obj.name)
+
+    def build(self, context, obj, job):
+        path = job.results[0]
+        volume = bakes.build_volume(context, obj, path)
+        return "Baked %s (%s)" % (volume.name, path)
+
+
+class DQJULIA_OT_bake_mesh(_BakeOperator, bpy.types.Operator):
+    """Mesh the set's surface at this frame and add it as a mesh object with normals and colours"""
+    bl_idname = "dqjulia.bake_mesh"
+    bl_label = "Bake Mesh"
+
+    def make_job(self, context, obj):
+        document = _bake_document(obj)
+        self._check_document(document)
+        self._cleanup = ()
+        return jobs.Job("Bake mesh", [jobs.MeshTask(document, colors=obj.dqjulia.bake_mesh_colors)], owner=obj.name)
+
+    def build(self, context, obj, job):
+        data = job.results[0]
+        if data.triangle_count == 0:
+            raise RuntimeError("the surface has no triangles at this resolution%s"
+                               % ("; " + job.warnings[0] if job.warnings else ""))
+        mesh = bakes.build_mesh(context, obj, data)
+        return "Baked %s: %d vertices, %d triangles" % (mesh.name, data.vertex_count, data.triangle_count)
+
+
+class DQJULIA_OT_bake_sequence(_BakeOperator, bpy.types.Operator):
+    """Bake a volume for every frame of the scene's frame range (the keyframed values of each frame) and add a Volume object that plays them back"""
+    bl_idname = "dqjulia.bake_sequence"
+    bl_label = "Bake Sequence"
+
+    def make_job(self, context, obj):
+        scene = context.scene
+        frames = list(range(scene.frame_start, scene.frame_end + 1))
+        if not frames:
+            raise ValueError("the scene's frame range is empty")
+        documents = animation.frame_documents(obj, scene, frames)
+        for frame, document in zip(frames, documents):
+            if "density" not in document["bake"]["grids"]:
+                document["bake"]["grids"].append("density")
+            try:
+                self._check_document(document)
+            except native.NativeError as error:
+                raise ValueError("frame %d: %s" % (frame, error.message))
+        directory = bakes.new_sequence_dir(obj, context)
+        self._cleanup = (directory,)
+        self._frames = frames
+        self._directory = directory
+        tasks = [jobs.VolumeTask(document, bakes.sequence_frame_path(directory, obj, frame), frame=frame)
+                 for frame, document in zip(frames, documents)]
+        return jobs.Job("Bake sequence", tasks, owner=obj.name)
+
+    def build(self, context, obj, job):
+        frames = self._frames
+        volume = bakes.build_volume(context, obj, job.results[0], sequence=(frames[0], len(frames), self._directory))
+        return "Baked %s: frames %d-%d in %s" % (volume.name, frames[0], frames[-1], self._directory)
+
+
+class DQJULIA_OT_cancel_bakes(bpy.types.Operator):
+    """Cancel the running bakes (same as Esc)"""
+    bl_idname = "dqjulia.cancel_bakes"
+    bl_label = "Cancel Bakes"
+
+    def execute(self, _context):
+        jobs.cancel_all()
+        return {"FINISHED"}
+
+
+class DQJULIA_OT_add_osl_volume(bpy.types.Operator):
+    """Add a cube over the bounds with a Cycles OSL volume material that computes the set while rendering (needs a Blender built with OSL)"""
+    bl_idname = "dqjulia.add_osl_volume"
+    bl_label = "Add OSL Volume"
+    bl_options = {"REGISTER", "UNDO"}
+
+    @classmethod
+    def poll(cls, context):
+        return dqjulia_object(context) is not None
+
+    def execute(self, context):
+        if not osl.available():
+            self.report({"ERROR"}, osl.UNAVAILABLE_MESSAGE)
+            return {"CANCELLED"}
+        try:
+            obj = osl.add_volume(context, dqjulia_object(context))
+        except (RuntimeError, native.NativeError) as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        self.report({"INFO"}, "Added %s (render with Cycles, Open Shading Language on)" % obj.name)
+        return {"FINISHED"}
+
+
+class DQJULIA_OT_open_osl_text(bpy.types.Operator):
+    """Load the OSL shader source into a text block (to read, or to use on a Blender with OSL)"""
+    bl_idname = "dqjulia.open_osl_text"
+    bl_label = "OSL Script to Text"
+
+    def execute(self, _context):
+        text = osl.shader_text()
+        self.report({"INFO"}, "The OSL source is in the text block %s" % text.name)
+        return {"FINISHED"}
+
+
+CLASSES = (DQJULIA_OT_add, DQJULIA_OT_load_preset, DQJULIA_OT_import_params, DQJULIA_OT_export_params,
+           DQJULIA_OT_collection_edit, DQJULIA_OT_bake_volume, DQJULIA_OT_bake_mesh, DQJULIA_OT_bake_sequence,
+           DQJULIA_OT_cancel_bakes, DQJULIA_OT_add_osl_volume, DQJULIA_OT_open_osl_text)
+
+
+def menu_add(self, _context):
+    self.layout.operator(DQJULIA_OT_add.bl_idname, text="DQ Julia", icon="OUTLINER_OB_VOLUME")
+
+
+def register():
+    for cls in CLASSES:
+        bpy.utils.register_class(cls)
+    bpy.types.VIEW3D_MT_add.append(menu_add)
+
+
+def unregister():
+    bpy.types.VIEW3D_MT_add.remove(menu_add)
+    for cls in reversed(CLASSES):
+        bpy.utils.unregister_class(cls)

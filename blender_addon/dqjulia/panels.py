@@ -1,0 +1,319 @@
+"""The UI: the same panels in the 3D view's sidebar (tab "DQ Julia") and in the object
+properties. Problems are shown where the user looks: a missing or mismatched library, the
+core's validation message for the current values, an empty slice and why, a bake's progress.
+"""
+
+import textwrap
+import time
+
+import bpy
+
+from . import jobs, native, operators, osl, preview, props
+
+
+def _wrapped(layout, text, icon="NONE", alert=False, width=56):
+    column = layout.column(align=True)
+    column.alert = alert
+    lines = textwrap.wrap(text, width) or [""]
+    for index, line in enumerate(lines):
+        column.label(text=line, icon=icon if index == 0 else "BLANK1")
+
+
+class DQJULIA_MT_presets(bpy.types.Menu):
+    bl_idname = "DQJULIA_MT_presets"
+    bl_label = "Presets"
+
+    def draw(self, _context):
+        layout = self.layout
+        for name in operators.preset_names():
+            layout.operator(operators.DQJULIA_OT_load_preset.bl_idname, text=name).preset = name
+
+
+class DQJULIA_UL_rotations(bpy.types.UIList):
+    bl_idname = "DQJULIA_UL_rotations"
+
+    def draw_item(self, _context, layout, _data, item, _icon, _active_data, _active_property, _index=0, _flt_flag=0):
+        row = layout.row(align=True)
+        row.prop(item, "first", text="")
+        row.label(icon="FORWARD")
+        row.prop(item, "second", text="")
+        row.prop(item, "degrees", text="")
+
+
+class _Base:
+    bl_options = set()
+
+    @classmethod
+    def poll(cls, context):
+        return operators.dqjulia_object(context) is not None
+
+
+last_sidebar_draw = 0.0  # when the sidebar's main panel last drew (the screenshot script reads it)
+
+
+class _MainPanel:
+    bl_label = "DQ Julia"
+
+    @classmethod
+    def poll(cls, context):
+        # Always in the sidebar (to offer "Add DQ Julia"); in the properties for DQ Julia objects.
+        return cls.bl_space_type == "VIEW_3D" or operators.dqjulia_object(context) is not None
+
+    def draw(self, context):
+        global last_sidebar_draw
+        if self.bl_space_type == "VIEW_3D":
+            last_sidebar_draw = time.monotonic()
+        layout = self.layout
+        error = native.load_error()
+        if error is not None:
+            box = layout.box()
+            _wrapped(box, "The dqjulia library cannot be used:", icon="ERROR", alert=True)
+            _wrapped(box, error, alert=True)
+            return
+        obj = operators.dqjulia_object(context)
+        if obj is None:
+            layout.label(text="The active object is not a DQ Julia object.")
+            layout.operator(operators.DQJULIA_OT_add.bl_idname, text="Add DQ Julia", icon="ADD")
+            return
+        s = obj.dqjulia
+        row = layout.row(align=True)
+        row.menu(DQJULIA_MT_presets.bl_idname, icon="PRESET")
+        row.operator(operators.DQJULIA_OT_import_params.bl_idname, text="", icon="IMPORT")
+        row.operator(operators.DQJULIA_OT_export_params.bl_idname, text="", icon="EXPORT")
+
+        column = layout.column()
+        column.prop(s, "variant")
+        column.prop(s, "iterations")
+        column.prop(s, "bailout")
+        column.label(text="Constant c = a + b eps (s, i, j, k):")
+        split = column.split(factor=0.5, align=True)
+        for name in ("c_a", "c_b"):
+            part = split.column(align=True)
+            part.label(text="a (real)" if name == "c_a" else "b (dual)")
+            part.prop(s, name, text="")
+
+        state = preview.state_for(obj)
+        if state.error:
+            box = layout.box()
+            _wrapped(box, state.error, icon="ERROR", alert=True)
+        elif state.empty_reason:
+            box = layout.box()
+            _wrapped(box, "Nothing to see: " + state.empty_reason, icon="INFO")
+        elif state.inspect:
+            box = layout.box()
+            column = box.column(align=True)
+            for part in ("real", "dual"):
+                report = state.inspect[part]
+                re_, im = report["complex"]
+                inside = report["in_mandelbrot"]
+                column.label(text="%s ~ %.4g %+.4gi" % ("a" if part == "real" else "b", re_, im),
+                             icon="CHECKMARK" if inside else "ERROR")
+                column.label(text="in the Mandelbrot set" if inside else "outside the Mandelbrot set: dust",
+                             icon="BLANK1")
+            column.label(text="Inside: %.1f%% of the bounds" % (100.0 * state.inspect["inside_fraction"]))
+        if preview.shader_error():
+            _wrapped(layout.box(), preview.shader_error(), icon="ERROR", alert=True)
+        for job in jobs.active_jobs(obj.name):
+            row = layout.row()
+            row.label(text=job.status_text(), icon="TIME")
+            row.operator(operators.DQJULIA_OT_cancel_bakes.bl_idname, text="", icon="CANCEL")
+
+
+class _SlicePanel(_Base):
+    bl_label = "Slice"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        s = operators.dqjulia_object(context).dqjulia
+        layout = self.layout
+        layout.prop(s, "axes_mode", expand=True)
+        if s.axes_mode == "NAMES":
+            row = layout.row(align=True)
+            row.prop(s, "axis_x")
+            row.prop(s, "axis_y")
+            row.prop(s, "axis_z")
+        else:
+            for name in ("axis_x_vector", "axis_y_vector", "axis_z_vector"):
+                layout.prop(s, name)
+        layout.prop(s, "origin")
+        layout.label(text="Rotations (applied in order):")
+        row = layout.row()
+        row.template_list(DQJULIA_UL_rotations.bl_idname, "", s, "rotations", s, "active_rotation", rows=2)
+        column = row.column(align=True)
+        add = column.operator(operators.DQJULIA_OT_collection_edit.bl_idname, text="", icon="ADD")
+        add.collection, add.action = "rotations", "ADD"
+        remove = column.operator(operators.DQJULIA_OT_collection_edit.bl_idname, text="", icon="REMOVE")
+        remove.collection, remove.action, remove.index = "rotations", "REMOVE", s.active_rotation
+
+
+class _BoundsPanel(_Base):
+    bl_label = "Bounds"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        obj = operators.dqjulia_object(context)
+        s = obj.dqjulia
+        layout = self.layout
+        layout.prop(s, "bounds_auto")
+        column = layout.column()
+        column.enabled = not s.bounds_auto
+        column.prop(s, "bounds_center")
+        column.prop(s, "bounds_radius")
+        state = preview.state_for(obj)
+        if state.bounds:
+            center, radius, clipped = state.bounds
+            layout.label(text="Sphere: centre (%.3g, %.3g, %.3g), radius %.4g%s" % (
+                center[0], center[1], center[2], radius, " (clips an extrusion)" if clipped else ""))
+
+
+class _PreviewPanel(_Base):
+    bl_label = "Viewport Preview"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        s = operators.dqjulia_object(context).dqjulia
+        layout = self.layout
+        row = layout.row()
+        row.prop(s, "show_preview")
+        row.prop(s, "show_bounds")
+        column = layout.column()
+        column.enabled = s.show_preview
+        column.prop(s, "preview_resolution")
+        column.prop(s, "preview_max_steps")
+        column.prop(s, "preview_detail")
+        column.prop(s, "step_factor")
+        column.prop(s, "max_step")
+        column.prop(s, "coloring")
+        if s.coloring == "solid":
+            column.prop(s, "color")
+
+
+class _BakePanel(_Base):
+    bl_label = "Bake"
+
+    def draw(self, context):
+        obj = operators.dqjulia_object(context)
+        s = obj.dqjulia
+        layout = self.layout
+        layout.prop(s, "bake_resolution")
+        flow = layout.grid_flow(columns=3, even_columns=True, align=True)
+        for name, _label, _description in props.GRID_ITEMS:
+            flow.prop_enum(s, "bake_grids", name)
+        layout.prop(s, "bake_band_width")
+        layout.prop(s, "bake_adaptivity")
+        layout.prop(s, "bake_mesh_colors")
+        layout.prop(s, "bake_bounds_auto")
+        if not s.bake_bounds_auto:
+            layout.prop(s, "bake_bounds_min")
+            layout.prop(s, "bake_bounds_max")
+        if native.load_error() is None and not native.has("dqj_bake_vdb"):
+            _wrapped(layout, "This dqjulia library cannot bake (built without OpenVDB baking).", icon="ERROR",
+                     alert=True)
+        column = layout.column(align=True)
+        column.operator(operators.DQJULIA_OT_bake_volume.bl_idname, icon="OUTLINER_OB_VOLUME")
+        column.operator(operators.DQJULIA_OT_bake_mesh.bl_idname, icon="MESH_ICOSPHERE")
+        scene = context.scene
+        column.operator(operators.DQJULIA_OT_bake_sequence.bl_idname, icon="RENDER_ANIMATION",
+                        text="Bake Sequence %d-%d" % (scene.frame_start, scene.frame_end))
+        for job in jobs.active_jobs(obj.name):
+            row = layout.row()
+            row.label(text=job.status_text(), icon="TIME")
+            row.operator(operators.DQJULIA_OT_cancel_bakes.bl_idname, text="Cancel", icon="CANCEL")
+        layout.label(text="Esc cancels a running bake.", icon="INFO")
+
+
+class _OslPanel(_Base):
+    bl_label = "OSL Volume (Cycles)"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, _context):
+        layout = self.layout
+        if not osl.available():
+            _wrapped(layout, osl.UNAVAILABLE_MESSAGE, icon="INFO")
+        row = layout.row(align=True)
+        row.enabled = osl.available()
+        row.operator(operators.DQJULIA_OT_add_osl_volume.bl_idname, icon="NODE_MATERIAL")
+        layout.operator(operators.DQJULIA_OT_open_osl_text.bl_idname, icon="TEXT")
+
+
+class _ShadingPanel(_Base):
+    bl_label = "Shading, Camera and Render (core)"
+    bl_options = {"DEFAULT_CLOSED"}
+
+    def draw(self, context):
+        s = operators.dqjulia_object(context).dqjulia
+        layout = self.layout
+        layout.label(text="Used by the core's renderer (dqjulia render) and the preview.")
+        column = layout.column()
+        column.prop(s, "coloring")
+        column.prop(s, "color")
+        row = column.row()
+        row.label(text="Palette")
+        add = row.operator(operators.DQJULIA_OT_collection_edit.bl_idname, text="", icon="ADD")
+        add.collection, add.action = "palette", "ADD"
+        remove = row.operator(operators.DQJULIA_OT_collection_edit.bl_idname, text="", icon="REMOVE")
+        remove.collection, remove.action = "palette", "REMOVE"
+        for entry in s.palette:
+            column.prop(entry, "color", text="")
+        for name in ("ambient", "diffuse", "specular", "shininess", "occlusion", "shadows", "shadow_softness"):
+            column.prop(s, name)
+        row = column.row()
+        row.label(text="Lights")
+        add = row.operator(operators.DQJULIA_OT_collection_edit.bl_idname, text="", icon="ADD")
+        add.collection, add.action = "lights", "ADD"
+        remove = row.operator(operators.DQJULIA_OT_collection_edit.bl_idname, text="", icon="REMOVE")
+        remove.collection, remove.action = "lights", "REMOVE"
+        for light in s.lights:
+            box = column.box()
+            box.prop(light, "direction")
+            row = box.row()
+            row.prop(light, "color", text="")
+            row.prop(light, "intensity")
+        column.separator()
+        column.prop(s, "camera_use_position")
+        if s.camera_use_position:
+            column.prop(s, "camera_position")
+        column.prop(s, "camera_use_target")
+        if s.camera_use_target:
+            column.prop(s, "camera_target")
+        column.prop(s, "camera_direction")
+        column.prop(s, "camera_up")
+        column.prop(s, "camera_fov")
+        column.separator()
+        row = column.row(align=True)
+        row.prop(s, "width")
+        row.prop(s, "height")
+        for name in ("samples", "max_steps", "detail", "normals", "background_top", "background_bottom",
+                     "output_path", "output_format", "description"):
+            column.prop(s, name)
+
+
+def _make_panels():
+    """The panel classes for both places: the sidebar and the object properties."""
+    spaces = {
+        "VIEW3D": {"bl_space_type": "VIEW_3D", "bl_region_type": "UI", "bl_category": "DQ Julia"},
+        "OBJECT": {"bl_space_type": "PROPERTIES", "bl_region_type": "WINDOW", "bl_context": "object"},
+    }
+    classes = []
+    for prefix, placement in spaces.items():
+        main_id = "%s_PT_dqjulia" % prefix
+        main = type(main_id, (_MainPanel, bpy.types.Panel), dict(placement, bl_idname=main_id))
+        classes.append(main)
+        for base in (_SlicePanel, _BoundsPanel, _PreviewPanel, _BakePanel, _OslPanel, _ShadingPanel):
+            name = "%s_PT_dqjulia_%s" % (prefix, base.__name__.strip("_").replace("Panel", "").lower())
+            attributes = dict(placement, bl_idname=name, bl_parent_id=main_id)
+            classes.append(type(name, (base, bpy.types.Panel), attributes))
+    return classes
+
+
+CLASSES = [DQJULIA_MT_presets, DQJULIA_UL_rotations] + _make_panels()
+
+
+def register():
+    for cls in CLASSES:
+        bpy.utils.register_class(cls)
+
+
+def unregister():
+    for cls in reversed(CLASSES):
+        bpy.utils.unregister_class(cls)

@@ -1,0 +1,23 @@
+# Stages the add-on and zips it (run by the blender_addon target):
+#   dqjulia/            the Python package, shaders/ and blender_manifest.toml
+#   dqjulia/_buildinfo.py
+#   dqjulia/presets/    examples/*.json
+#   dqjulia/lib/libdqjulia.so   the real library file (not a symlink)
+cmake_minimum_required(VERSION 3.25)
+file(REMOVE_RECURSE "${STAGE}")
+file(MAKE_DIRECTORY "${STAGE}/dqjulia/lib" "${STAGE}/dqjulia/presets")
+file(COPY "${SOURCE}/" DESTINATION "${STAGE}/dqjulia"
+     PATTERN "__pycache__" EXCLUDE PATTERN "*.pyc" EXCLUDE)
+file(COPY "${BUILDINFO}" DESTINATION "${STAGE}/dqjulia")
+file(GLOB examples "${EXAMPLES}/*.json")
+file(COPY ${examples} DESTINATION "${STAGE}/dqjulia/presets")
+file(COPY_FILE "${LIBRARY}" "${STAGE}/dqjulia/lib/libdqjulia.so")
+get_filename_component(zip_dir "${ZIP}" DIRECTORY)
+file(MAKE_DIRECTORY "${zip_dir}")
+file(REMOVE "${ZIP}.tmp")
+execute_process(COMMAND "${CMAKE_COMMAND}" -E tar cf "${ZIP}.tmp" --format=zip dqjulia
+                WORKING_DIRECTORY "${STAGE}" RESULT_VARIABLE result)
+if(NOT result EQUAL 0)
+  message(FATAL_ERROR "could not write ${ZIP}")
+endif()
+file(RENAME "${ZIP}.tmp" "${ZIP}")

@@ -1,0 +1,193 @@
+#include "bake_options.hpp"
+
+#include <sys/resource.h>
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+
+namespace dqj::cli {
+namespace {
+
+std::string shortCount(std::uint64_t count) {
+    char text[32];
+    if (count >= 1000000000)
+        std::snprintf(text, sizeof text, "%.2fG", count / 1e9);
+    else if (count >= 1000000)
+        std::snprintf(text, sizeof text, "%.1fM", count / 1e6);
+    else if (count >= 1000)
+        std::snprintf(text, sizeof text, "%.1fk", count / 1e3);
+    else
+        std::snprintf(text, sizeof text, "%llu", static_cast<unsigned long long>(count));
+    return text;
+}
+
+std::string percent(std::uint64_t part, std::uint64_t whole) {
+    char text[16];
+    std::snprintf(text, sizeof text, "%.1f%%", whole ? 100.0 * double(part) / double(whole) : 0.0);
+    return text;
+}
+
+int parseFrame(const std::string& text, const std::string& whole) {
+    std::size_t used = 0;
+    long value = -1;
+    try {
+        value = std::stol(text, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (text.empty() || used != text.size() || value < 0 || value > 999999 || text[0] == '+' || text[0] == '-')
+        throw ParamError("frames", "--frames \"" + whole + "\": expected FIRST-LAST with whole frame numbers from 0 to 999999, e.g. 1-48");
+    return int(value);
+}
+
+}  // namespace
+
+void BakeFlags::addTo(CLI::App& command, bool mesh) {
+    fractal.addTo(command);
+    command.add_option("-o,--output", output, mesh ? "Output mesh: .ply (binary) or .obj" : "Output OpenVDB file (.vdb)")
+        ->required();
+    command.add_option("-r,--resolution", resolution, "Voxels across the largest side of the bounds (8..16384; default 256)")
+        ->check(CLI::Range(8, 16384));
+    command.add_option("--bounds-min", boundsMin, "Bake only this box: its lowest corner x y z (with --bounds-max)")->expected(3);
+    command.add_option("--bounds-max", boundsMax, "Bake only this box: its highest corner x y z (with --bounds-min)")->expected(3);
+    if (mesh) {
+        command.add_option("--adaptivity", adaptivity, "0 = uniform quads; up to 1 merges flat regions into fewer polygons")
+            ->check(CLI::Range(0.0, 1.0));
+        command.add_flag("--no-colors", noColors, "No vertex colours");
+    } else {
+        command.add_option("--grids", grids, "Grids to write, comma-separated: surface, density, color, trap, iterations "
+                                             "(default surface,density)");
+        command.add_option("--band-width", bandWidth, "Half width of the level set's narrow band in voxels (1..32; default 3)")
+            ->check(CLI::Range(1.0, 32.0));
+    }
+    command.add_option("--frames", frames, "Keyframed parameters: bake frames FIRST-LAST into NAME_0001.EXT, ... (or one frame)");
+    command.add_option("--max-memory", maxMemory, "Refuse when the estimate exceeds this, e.g. 4G or 512M (default: half the available memory)");
+    command.add_flag("--dense", dense, "Evaluate every voxel instead of skipping empty blocks (slow; for comparisons)");
+    command.add_flag("-f,--force", force, "Overwrite existing output files");
+    command.add_flag("-q,--quiet", quiet, "No progress bar or summary");
+    command.add_flag("--stats", stats, "Print time, voxels evaluated against dense, active voxels and peak memory to stdout");
+}
+
+Params BakeFlags::load() const {
+    Params params = fractal.paramsFile.empty() ? Params{} : loadParams(fractal.paramsFile, Validation::TypesOnly);
+    fractal.applyTo(params);
+    BakeSettings& bake = params.bake;
+    if (resolution) bake.resolution = *resolution;
+    if (boundsMin.empty() != boundsMax.empty())
+        throw ParamError("bake.bounds", "--bounds-min and --bounds-max go together: give both corners of the box");
+    if (!boundsMin.empty())
+        bake.bounds = Box{{boundsMin[0], boundsMin[1], boundsMin[2]}, {boundsMax[0], boundsMax[1], boundsMax[2]}};
+    if (bandWidth) bake.bandWidth = *bandWidth;
+    if (adaptivity) bake.adaptivity = *adaptivity;
+    if (noColors) bake.meshColors = false;
+    if (!grids.empty()) {
+        bake.grids.clear();
+        std::size_t start = 0;
+        while (start <= grids.size()) {
+            const std::size_t comma = std::min(grids.find(',', start), grids.size());
+            const std::string name = grids.substr(start, comma - start);
+            bool known = false;
+            for (BakeGrid grid : {BakeGrid::Surface, BakeGrid::Density, BakeGrid::Color, BakeGrid::Trap, BakeGrid::Iterations}) {
+                if (name != bakeGridName(grid)) continue;
+                known = true;
+                if (!hasGrid(bake, grid)) bake.grids.push_back(grid);
+            }
+            if (!known)
+                throw ParamError("bake.grids", "--grids: unknown grid \"" + name +
+                                                   "\" (grids: surface, density, color, trap, iterations)");
+            start = comma + 1;
+        }
+    }
+    validate(params);
+    return params;
+}
+
+std::optional<FrameRange> BakeFlags::frameRange() const {
+    if (frames.empty()) return std::nullopt;
+    const std::size_t dash = frames.find('-');
+    FrameRange range;
+    range.first = parseFrame(frames.substr(0, dash), frames);
+    range.last = dash == std::string::npos ? range.first : parseFrame(frames.substr(dash + 1), frames);
+    if (range.last < range.first)
+        throw ParamError("frames", "--frames \"" + frames + "\": the last frame comes before the first; write FIRST-LAST, e.g. 1-48");
+    return range;
+}
+
+std::uint64_t BakeFlags::memoryLimit() const {
+    if (maxMemory.empty()) return 0;
+    const std::string message = "--max-memory \"" + maxMemory + "\": expected a size such as 512M, 4G or 1.5G (or bytes)";
+    std::size_t used = 0;
+    double value = 0.0;
+    try {
+        value = std::stod(maxMemory, &used);
+    } catch (const std::exception&) {
+        throw ParamError("max-memory", message);
+    }
+    std::string unit = maxMemory.substr(used);
+    if (!unit.empty() && (unit.back() == 'B' || unit.back() == 'b')) unit.pop_back();
+    double scale = 1.0;
+    if (unit == "k" || unit == "K")
+        scale = 1e3;
+    else if (unit == "M" || unit == "m")
+        scale = 1e6;
+    else if (unit == "G" || unit == "g")
+        scale = 1e9;
+    else if (unit == "T" || unit == "t")
+        scale = 1e12;
+    else if (!unit.empty())
+        throw ParamError("max-memory", message);
+    if (!std::isfinite(value) || value * scale < 1.0 || value * scale > 1e18) throw ParamError("max-memory", message);
+    return std::uint64_t(value * scale);
+}
+
+std::string framePath(const std::string& path, int frame) {
+    const std::size_t slash = path.find_last_of('/');
+    std::size_t dot = path.rfind('.');
+    if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) dot = path.size();
+    char number[16];
+    std::snprintf(number, sizeof number, "_%04d", frame);
+    return path.substr(0, dot) + number + path.substr(dot);
+}
+
+Params paramsAtFrame(const Params& params, int frame) {
+    if (params.animation.empty()) return params;
+    Params result = atFrame(params, frame);
+    try {
+        validate(result);
+    } catch (const ParamError& error) {
+        throw ParamError(error.key(), "at frame " + std::to_string(frame) + ": " + error.what());
+    }
+    return result;
+}
+
+ProgressCallback bakeProgress(ProgressBar& bar, const BakeMonitor& monitor) {
+    ProgressCallback draw = bar.callback();
+    return [&bar, &monitor, draw](double fraction) {
+        bar.setStatus(std::string(bakeStageName(monitor.stage.load())) + ", " + shortCount(monitor.evaluated.load()) +
+                      " of " + shortCount(monitor.dense.load()) + " voxels evaluated");
+        return draw(fraction);
+    };
+}
+
+std::string evaluatedSummary(const BakeStats& stats) {
+    return "evaluated " + shortCount(stats.evaluated) + " of " + shortCount(stats.dense) + " voxels (" +
+           percent(stats.evaluated, stats.dense) + ")";
+}
+
+void printBakeStats(const BakeStats& stats) {
+    rusage usage{};
+    ::getrusage(RUSAGE_SELF, &usage);
+    std::cout << "seconds " << stats.seconds << "\n"
+              << "voxel_size " << stats.voxelSize << "\n"
+              << "voxels_evaluated " << stats.evaluated << "\n"
+              << "voxels_dense " << stats.dense << "\n"
+              << "evaluated_fraction " << (stats.dense ? double(stats.evaluated) / double(stats.dense) : 0.0) << "\n"
+              << "sampled_leaves " << stats.sampledLeaves << "\n"
+              << "interior_leaves " << stats.interiorLeaves << "\n"
+              << "active_voxels " << stats.activeVoxels << "\n"
+              << "estimated_bytes " << stats.estimatedBytes << "\n"
+              << "peak_memory_bytes " << std::uint64_t(usage.ru_maxrss) * 1024 << "\n";
+}
+
+}  // namespace dqj::cli

@@ -1,0 +1,65 @@
+// What `dqjulia bake` and `dqjulia mesh` share: their flags, frame ranges and output names,
+// the memory limit, the progress display and the --stats report.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "common.hpp"
+#include "dqjulia/bake.hpp"
+#include "dqjulia/params.hpp"
+
+namespace dqj::cli {
+
+/// An inclusive range of whole frames (--frames A-B, or A alone).
+struct FrameRange {
+    int first = 1;
+    int last = 1;
+};
+
+struct BakeFlags {
+    FractalOptions fractal;
+    std::string output;
+    std::optional<int> resolution;
+    std::vector<double> boundsMin, boundsMax;
+    std::optional<double> bandWidth;
+    std::string grids;
+    std::string frames;
+    std::string maxMemory;
+    std::optional<double> adaptivity;  // mesh only
+    bool noColors = false;             // mesh only
+    bool dense = false;
+    bool force = false;
+    bool quiet = false;
+    bool stats = false;
+
+    /// Registers the flags; `mesh` adds --adaptivity and --no-colors, else --grids and --band-width.
+    void addTo(CLI::App& command, bool mesh);
+    /// Defaults, the file, then the flags; validated. Throws ParamError.
+    Params load() const;
+    /// --frames, if given. Throws ParamError for a malformed or reversed range.
+    std::optional<FrameRange> frameRange() const;
+    /// --max-memory in bytes, or 0 for the default. Throws ParamError.
+    std::uint64_t memoryLimit() const;
+};
+
+/// "out/fractal.vdb", 12 -> "out/fractal_0012.vdb": the numbering Blender reads as a sequence.
+std::string framePath(const std::string& path, int frame);
+
+/// The parameters at `frame` (keyframes applied), validated; errors name the frame.
+Params paramsAtFrame(const Params& params, int frame);
+
+/// A progress callback that draws the bar with the bake's stage and evaluated/dense counts.
+ProgressCallback bakeProgress(ProgressBar& bar, const BakeMonitor& monitor);
+
+/// "evaluated 3.2M of 16.8M voxels (19%)".
+std::string evaluatedSummary(const BakeStats& stats);
+
+/// The lines --stats prints for one bake (stdout), peak memory included.
+void printBakeStats(const BakeStats& stats);
+
+}  // namespace dqj::cli

@@ -1,0 +1,93 @@
+// dqjulia mesh: the baked surface as a PLY or OBJ mesh (normals, vertex colours), one file or,
+// with --frames, one file per frame of an animation.
+#include <iomanip>
+#include <iostream>
+
+#include "bake_options.hpp"
+#include "commands.hpp"
+#include "common.hpp"
+#include "dqjulia/inspect.hpp"
+#include "dqjulia/mesh.hpp"
+
+namespace dqj::cli {
+namespace {
+
+int runMesh(const BakeFlags& flags) {
+    const Params params = flags.load();
+    std::string extension = flags.output.size() >= 4 ? flags.output.substr(flags.output.size() - 4) : "";
+    for (char& ch : extension) ch = char(std::tolower(static_cast<unsigned char>(ch)));
+    if (extension != ".ply" && extension != ".obj")
+        throw ParamError("output.path", "--output '" + flags.output + "' must end in .ply or .obj");
+    const std::uint64_t memoryLimit = flags.memoryLimit();
+
+    std::vector<int> frames;
+    if (const auto range = flags.frameRange()) {
+        for (int frame = range->first; frame <= range->last; ++frame) frames.push_back(frame);
+    } else {
+        frames.push_back(1);
+    }
+    std::vector<Params> perFrame;
+    std::vector<std::string> paths;
+    for (int frame : frames) {
+        perFrame.push_back(paramsAtFrame(params, frame));
+        paths.push_back(flags.frameRange() ? framePath(flags.output, frame) : flags.output);
+        checkOutputPath(paths.back(), flags.force);
+    }
+
+    for (std::size_t index = 0; index < frames.size(); ++index) {
+        BakeMonitor monitor;
+        BakeOptions options;
+        options.dense = flags.dense;
+        options.memoryLimit = memoryLimit;
+        options.monitor = &monitor;
+        BakeStats stats;
+        Mesh mesh;
+        {
+            ProgressBar bar(frames.size() > 1 ? "meshing frame " + std::to_string(frames[index]) : "meshing", flags.quiet);
+            try {
+                mesh = bakeMesh(perFrame[index], options, bakeProgress(bar, monitor), &stats);
+            } catch (const Cancelled&) {
+                bar.finish();
+                if (index == 0) throw;
+                std::cerr << "dqjulia mesh: interrupted at frame " << frames[index] << "; frames " << frames.front() << " to "
+                          << frames[index - 1] << " were written, frame " << frames[index] << " was not\n";
+                return kInterrupted;
+            }
+            bar.finish();
+        }
+        if (interrupted()) {  // a signal during the last moments of the work: write nothing
+            std::cerr << "dqjulia mesh: interrupted; " << paths[index] << " was not written\n";
+            return kInterrupted;
+        }
+        writeMesh(mesh, paths[index]);
+        if (mesh.positions.empty()) {
+            const std::string reason = inspect(perFrame[index]).emptyReason;
+            std::cerr << "dqjulia mesh: warning: " << paths[index] << " is empty: "
+                      << (reason.empty() ? "nothing within the bounds is in the set at this resolution" : reason) << "\n";
+        }
+        if (!flags.quiet)
+            std::cerr << "wrote " << paths[index] << " (" << mesh.positions.size() << " vertices, "
+                      << mesh.quads.size() + mesh.triangles.size() << " faces; " << evaluatedSummary(stats) << "; "
+                      << std::fixed << std::setprecision(2) << stats.seconds << " s)\n"
+                      << std::defaultfloat;
+        if (flags.stats) {
+            if (frames.size() > 1) std::cout << "frame " << frames[index] << "\n";
+            printBakeStats(stats);
+            std::cout << "vertices " << mesh.positions.size() << "\nfaces " << mesh.quads.size() + mesh.triangles.size()
+                      << "\nquads " << mesh.quads.size() << "\ntriangles " << mesh.triangles.size() << "\ntriangulated "
+                      << mesh.triangleCount() << "\n";
+        }
+    }
+    return kSuccess;
+}
+
+}  // namespace
+
+Runner addMeshCommand(CLI::App& app) {
+    auto flags = std::make_shared<BakeFlags>();
+    CLI::App* command = app.add_subcommand("mesh", "Mesh the baked surface into a PLY or OBJ file (README: Baking)");
+    flags->addTo(*command, true);
+    return [flags] { return reportErrors("mesh", [&] { return runMesh(*flags); }); };
+}
+
+}  // namespace dqj::cli

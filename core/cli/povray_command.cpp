@@ -1,0 +1,114 @@
+// dqjulia povray: write a POV-Ray scene that draws what `dqjulia render` draws (and a DF3 grid).
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include "commands.hpp"
+#include "common.hpp"
+#include "dqjulia/inspect.hpp"
+#include "dqjulia/povray.hpp"
+
+namespace dqj::cli {
+namespace {
+
+struct PovrayOptions {
+    FractalOptions fractal;
+    std::string output;
+    std::optional<int> width, height, samples;
+    std::optional<double> detail, fov;
+    std::string coloring;
+    bool df3 = false;
+    int df3Resolution = 128;
+    int df3Bits = 16;
+    bool noInclude = false;
+    bool force = false;
+    bool quiet = false;
+};
+
+int runPovray(const PovrayOptions& options) {
+    Params params = options.fractal.paramsFile.empty() ? Params{} : loadParams(options.fractal.paramsFile, Validation::TypesOnly);
+    options.fractal.applyTo(params);
+    if (options.width) params.render.width = *options.width;
+    if (options.height) params.render.height = *options.height;
+    if (options.samples) params.render.samples = *options.samples;
+    if (options.detail) params.render.detail = *options.detail;
+    if (options.fov) params.camera.fovDegrees = *options.fov;
+    if (!options.coloring.empty())
+        params.material.coloring = options.coloring == "solid"        ? Coloring::Solid
+                                   : options.coloring == "iterations" ? Coloring::Iterations
+                                                                      : Coloring::Trap;
+    validate(params);
+    // An empty picture needs a reason, in POV-Ray as in `dqjulia render`.
+    const std::string provenEmpty = provenEmptyReason(params);
+    if (!provenEmpty.empty())
+        std::cerr << "dqjulia povray: warning: the scene has no fractal: " << provenEmpty << "\n";
+
+    PovrayWriteOptions write;
+    write.copyInclude = !options.noInclude;
+    write.df3 = options.df3;
+    write.df3Resolution = options.df3Resolution;
+    write.df3Bits = options.df3Bits;
+    write.sourceName = options.fractal.paramsFile;
+    // Check every output before the work: existing files need --force. An identical copy of
+    // the include is fine (several scenes share one folder); a different one is not replaced silently.
+    const PovrayFiles files = povrayFiles(params, options.output, write);
+    if (!files.scene.empty()) checkOutputPath(files.scene, options.force);
+    if (!files.df3.empty()) checkOutputPath(files.df3, options.force, "--df3");
+    if (!files.df3Scene.empty()) checkOutputPath(files.df3Scene, options.force, "--df3");
+    if (!files.include.empty()) {
+        std::ifstream existing(files.include, std::ios::binary);
+        std::ostringstream text;
+        text << existing.rdbuf();
+        if (existing && text.str() != povrayInclude() && !options.force)
+            throw ParamError("output.path", "'" + files.include +
+                                                "' exists and differs from this version's dqjulia.inc; pass --force to "
+                                                "replace it, or --no-include to keep it");
+        if (!existing) checkOutputPath(files.include, options.force);
+    }
+    if (files.scene.empty())
+        std::cerr << "dqjulia povray: N = " << params.fractal.iterations
+                  << " is beyond dqjulia.inc's limit of 1000 iterations (POV-Ray's function call depth): "
+                     "writing only the DF3 scene\n";
+    ProgressBar progress("baking", options.quiet || !options.df3);
+    const std::vector<std::string> written = writePovray(params, options.output, write, progress.callback());
+    progress.finish();
+    if (!options.quiet) {
+        for (const std::string& path : written) std::cerr << "wrote " << path << "\n";
+        const std::string scene = files.scene.empty() ? files.df3Scene : files.scene;
+        std::cerr << "render with: " << povrayCommand(params, scene)
+                  << (write.copyInclude ? "" : " +L<dqjulia>/povray") << "\n";
+    }
+    return kSuccess;
+}
+
+}  // namespace
+
+Runner addPovrayCommand(CLI::App& app) {
+    auto options = std::make_shared<PovrayOptions>();
+    CLI::App* command = app.add_subcommand(
+        "povray", "Write a POV-Ray 3.7 scene (camera, lights, material, background) that draws what `render` draws,\n"
+                  "the fractal as an isosurface of the same distance estimate (dqjulia.inc, written beside it)");
+    options->fractal.addTo(*command);
+    command->add_option("-o,--output", options->output, "Scene file to write, e.g. scene.pov")->required();
+    command->add_option("-W,--width", options->width, "Image width the view is framed for");
+    command->add_option("-H,--height", options->height, "Image height the view is framed for");
+    command->add_option("-s,--samples", options->samples, "Anti-aliasing: S x S rays per pixel (in the render command)");
+    command->add_option("--detail", options->detail, "Hit threshold in pixel footprints (smaller = finer)");
+    command->add_option("--fov", options->fov, "Vertical field of view in degrees");
+    command->add_option("--coloring", options->coloring, "solid, iterations or trap")
+        ->check(CLI::IsMember({"solid", "iterations", "trap"}));
+    command->add_flag("--df3", options->df3,
+                      "Also bake <scene>.df3 (the distance estimate on a grid) and <scene>_df3.pov drawing it: fast\n"
+                      "renders of heavy settings, at the grid's resolution");
+    command->add_option("--df3-resolution", options->df3Resolution, "Samples per axis of the DF3 grid")
+        ->check(CLI::Range(2, 1024));
+    command->add_option("--df3-bits", options->df3Bits, "Bits per DF3 sample: 8, 16 or 32")
+        ->check(CLI::IsMember({8, 16, 32}));
+    command->add_flag("--no-include", options->noInclude,
+                      "Do not write dqjulia.inc beside the scene (render with +L<dqjulia>/povray)");
+    command->add_flag("-f,--force", options->force, "Overwrite existing output files");
+    command->add_flag("-q,--quiet", options->quiet, "No progress bar or summary");
+    return [options] { return reportErrors("povray", [&] { return runPovray(*options); }); };
+}
+
+}  // namespace dqj::cli

@@ -1,0 +1,51 @@
+// dqjulia/mesh.hpp - a polygon mesh of the baked surface, and PLY / OBJ files of it.
+//
+// The mesh is OpenVDB's volumeToMesh of the bake's surface function (bake.hpp) at
+// bake.adaptivity - the very surface the bake's level set holds, since levelSetRebuild is the
+// distance to this mesh. Quads (and, with adaptivity, triangles), one vertex per surface cell,
+// closed wherever the surface is closed (always: the solid is cut to the bounds), no face with
+// a repeated vertex. Vertex normals are the area-weighted average of the faces around them;
+// colours are the material's colouring of the orbit at each vertex (as the renderer shades it).
+// Cost: the bake's sparse sampling, a volumeToMesh, and one fractal evaluation per vertex for
+// colours; no level set is built.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <glm/vec3.hpp>
+
+#include "dqjulia/bake.hpp"
+#include "dqjulia/export.h"
+#include "dqjulia/params.hpp"
+#include "dqjulia/progress.hpp"
+
+namespace dqj {
+
+struct Mesh {
+    std::vector<glm::vec3> positions;  ///< slice coordinates
+    std::vector<glm::vec3> normals;    ///< unit, out of the solid; one per vertex
+    std::vector<glm::vec3> colors;     ///< linear RGB per vertex; empty without mesh colours
+    std::vector<std::array<std::uint32_t, 3>> triangles;  ///< counter-clockwise seen from outside
+    std::vector<std::array<std::uint32_t, 4>> quads;      ///< counter-clockwise seen from outside
+
+    /// Triangles once every quad is split in two.
+    std::size_t triangleCount() const { return triangles.size() + 2 * quads.size(); }
+    /// Every face as triangles (quads split along their 0-2 diagonal), 3 indices each.
+    DQJ_API std::vector<std::uint32_t> triangulated() const;
+};
+
+/// Meshes `params` (validated; see bakeVdb for frames). Throws like bakeVdb. `stats` (optional)
+/// receives the bake's counters.
+DQJ_API Mesh bakeMesh(const Params& params, const BakeOptions& options = {}, const ProgressCallback& progress = {},
+                      BakeStats* stats = nullptr);
+
+/// Writes `.ply` (binary little-endian: float positions and normals, 8-bit sRGB colours,
+/// quads and triangles) or `.obj` (text: `v x y z [r g b]`, `vn`, `f a//a ...`), by the path's
+/// extension. Temporary file + rename. Throws ParamError for another extension,
+/// std::runtime_error for I/O.
+DQJ_API void writeMesh(const Mesh& mesh, const std::string& path);
+
+}  // namespace dqj

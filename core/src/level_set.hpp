@@ -1,0 +1,28 @@
+// level_set.hpp - the first half of every bake: sample the surface function sparsely and turn
+// it into an exact narrow-band signed distance (internal to libdqjulia).
+//
+// f (sparse_sampler.hpp) is zero on the surface but is not a distance; OpenVDB's
+// levelSetRebuild meshes f = 0 and rasterises that mesh into a signed distance with the bake's
+// band width (exact distance to the mesh, negative inside). Cost: the sampling, then about one
+// mesh vertex and a band's worth of voxels per surface voxel; interruptible.
+#pragma once
+
+#include <openvdb/openvdb.h>
+
+#include "dqjulia/bake.hpp"
+#include "dqjulia/params.hpp"
+#include "sparse_sampler.hpp"
+#include "staged_progress.hpp"
+
+namespace dqj {
+
+/// Registers OpenVDB's grid types once (thread-safe).
+void initializeOpenVdb();
+
+/// The level set "surface" of `params` (validated). Progress: classification in [0, 0.03 of
+/// the share], sampling up to `sampledAt`, the rebuild up to `rebuiltAt`. Fills `stats` (all
+/// but seconds). Throws MemoryLimitError, Cancelled.
+openvdb::FloatGrid::Ptr bakeLevelSet(const Params& params, const BakeOptions& options, const MemoryModel& memory,
+                                     StagedProgress& progress, BakeStats& stats, double sampledAt, double rebuiltAt);
+
+}  // namespace dqj

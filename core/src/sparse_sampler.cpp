@@ -1,0 +1,362 @@
+// The sparse sampler (sparse_sampler.hpp): classify blocks, sample leaves in waves, assemble.
+#include "sparse_sampler.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include <glm/common.hpp>
+#include <glm/geometric.hpp>
+
+#include "dqjulia/ball_bound.hpp"
+#include "dqjulia/render.hpp"
+#include "parallel_progress.hpp"
+
+namespace dqj {
+
+using openvdb::Coord;
+using openvdb::CoordBBox;
+using FloatLeaf = openvdb::FloatTree::LeafNodeType;
+
+namespace {
+
+constexpr int kLeafSize = int(FloatLeaf::DIM);  // 8
+constexpr int kTopBlockSize = 64;               // classification starts with blocks this big
+constexpr double kFloatLeafBytes = sizeof(FloatLeaf) + 64.0;  // a leaf and its share of the tree
+
+/// A leaf's state during sampling, stored per leaf (key = origin / 8).
+enum LeafState : int {
+    kSkipped = 0,   ///< proven to hold no surface (the tree's background)
+    kSurface = 1,   ///< to sample
+    kDeferred = 2,  ///< centre inside the set: sampled only if the surface reaches it
+    kQueued = 3     ///< a deferred leaf that the surface reached: sampled
+};
+
+Coord leafKey(const Coord& origin) { return Coord(origin.x() >> 3, origin.y() >> 3, origin.z() >> 3); }
+
+glm::dvec3 voxelCentre(const Coord& ijk, double h) { return glm::dvec3(ijk.x(), ijk.y(), ijk.z()) * h; }
+
+/// Does the leaf have a voxel that is not inside (f >= 0) on its boundary towards the neighbour
+/// at offset (dx, dy, dz) (each -1, 0 or 1): a face, an edge or a corner?
+bool outsideTowards(const FloatLeaf& leaf, int dx, int dy, int dz) {
+    auto range = [](int d, int& low, int& high) {
+        low = d > 0 ? kLeafSize - 1 : 0;
+        high = d < 0 ? 0 : kLeafSize - 1;
+    };
+    int x0, x1, y0, y1, z0, z1;
+    range(dx, x0, x1);
+    range(dy, y0, y1);
+    range(dz, z0, z1);
+    for (int x = x0; x <= x1; ++x)
+        for (int y = y0; y <= y1; ++y)
+            for (int z = z0; z <= z1; ++z)
+                if (!(leaf.getValue(FloatLeaf::coordToOffset(Coord(x, y, z))) < 0.0f)) return true;
+    return false;
+}
+
+/// The 26 neighbour offsets.
+std::vector<Coord> neighbourOffsets() {
+    std::vector<Coord> offsets;
+    for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dz = -1; dz <= 1; ++dz)
+                if (dx != 0 || dy != 0 || dz != 0) offsets.emplace_back(dx, dy, dz);
+    return offsets;
+}
+
+double largestStretch(Slice slice, bool keepReal, bool keepDual) {
+    for (Vec8& axis : slice.axes)
+        for (int index = 0; index < 8; ++index)
+            if ((index < 4 && !keepReal) || (index >= 4 && !keepDual)) axis[index] = 0.0;
+    return stretchOf(slice).max;
+}
+
+/// Classification and sampling for one bake.
+class Sampler {
+public:
+    Sampler(const Params& params, const BakeOptions& options, const MemoryModel& memory, StagedProgress& progress)
+        : params_(params),
+          options_(options),
+          memory_(memory),
+          progress_(progress),
+          f_(params, bakeVoxelSize(params)),
+          h_(f_.voxelSize()) {
+        const Box& box = f_.region().box();
+        constexpr int kPadding = 2;  // voxels beyond the bounds, so the cut face closes
+        for (int axis = 0; axis < 3; ++axis) {
+            lo_[axis] = int(std::floor(box.min[axis] / h_)) - kPadding;
+            hi_[axis] = int(std::ceil(box.max[axis] / h_)) + kPadding;
+            dense_ *= std::uint64_t(std::max<long long>(1, std::llround((box.max[axis] - box.min[axis]) / h_)));
+        }
+        indexBox_ = CoordBBox(lo_, hi_);
+        limit_ = options.memoryLimit ? options.memoryLimit : defaultMemoryLimit();
+    }
+
+    SampledSurface run(double split, double end) {
+        progress_.setDense(dense_);
+        std::vector<Coord> wave;
+        if (options_.dense) {
+            wave = allLeaves();  // nothing to classify: every leaf is sampled
+            checkMemory(wave.size(), true);
+        } else {
+            wave = classify(split);
+        }
+
+        openvdb::FloatTree::Ptr tree(new openvdb::FloatTree(f_.background()));
+        // Waves: the first holds most of the work; later ones (deferred leaves the surface
+        // reached) share the rest of the stage, each half of what remains.
+        double begin = split, finish = split + 0.9 * (end - split);
+        const std::vector<Coord> offsets = neighbourOffsets();
+        while (!wave.empty()) {
+            std::vector<std::unique_ptr<FloatLeaf>> leaves = sampleLeaves(wave, progress_.stage(BakeStage::Sampling, begin, finish));
+            std::vector<Coord> next;
+            for (const auto& leaf : leaves) {
+                const Coord key = leafKey(leaf->origin());
+                for (const Coord& offset : offsets) {
+                    const Coord neighbour = key + offset;
+                    if (states_.getValue(neighbour) != kDeferred) continue;
+                    if (!outsideTowards(*leaf, offset.x(), offset.y(), offset.z())) continue;
+                    states_.setValue(neighbour, kQueued);
+                    next.push_back(leaf->origin().offsetBy(offset.x() * kLeafSize, offset.y() * kLeafSize, offset.z() * kLeafSize));
+                }
+            }
+            stats_.sampledLeaves += leaves.size();
+            for (auto& leaf : leaves) tree->addLeaf(leaf.release());
+            wave = std::move(next);
+            begin = finish;
+            finish = begin + 0.5 * (end - begin);
+        }
+
+        // Deferred leaves the surface never reached are inside the set: constant tiles.
+        for (auto it = states_.cbeginValueOn(); it; ++it) {
+            if (*it != kDeferred) continue;
+            const Coord key = it.getCoord();
+            tree->addTile(1, Coord(key.x() * kLeafSize, key.y() * kLeafSize, key.z() * kLeafSize), float(-f_.epsilon()), false);
+            ++stats_.interiorLeaves;
+        }
+
+        SampledSurface result;
+        result.grid = openvdb::FloatGrid::create(tree);
+        result.grid->setTransform(openvdb::math::Transform::createLinearTransform(h_));
+        result.grid->setName("f");
+        stats_.evaluated = evaluated_.load();
+        stats_.dense = dense_;
+        stats_.voxelSize = h_;
+        result.stats = stats_;
+        return result;
+    }
+
+private:
+    std::vector<Coord> allLeaves() const {
+        std::vector<Coord> leaves;
+        for (int x = floorTo(lo_.x(), kLeafSize); x <= hi_.x(); x += kLeafSize)
+            for (int y = floorTo(lo_.y(), kLeafSize); y <= hi_.y(); y += kLeafSize)
+                for (int z = floorTo(lo_.z(), kLeafSize); z <= hi_.z(); z += kLeafSize) leaves.emplace_back(x, y, z);
+        return leaves;
+    }
+
+    static int floorTo(int value, int step) { return int(std::floor(double(value) / step)) * step; }
+
+    struct Lists {
+        std::vector<Coord> surface;
+        std::vector<Coord> deferred;
+    };
+
+    /// Classifies every leaf; returns the first wave to sample (surface leaves and deferred
+    /// leaves next to skipped space) after checking the memory estimate.
+    std::vector<Coord> classify(double split) {
+        std::vector<Coord> blocks;
+        for (int x = floorTo(lo_.x(), kTopBlockSize); x <= hi_.x(); x += kTopBlockSize)
+            for (int y = floorTo(lo_.y(), kTopBlockSize); y <= hi_.y(); y += kTopBlockSize)
+                for (int z = floorTo(lo_.z(), kTopBlockSize); z <= hi_.z(); z += kTopBlockSize) blocks.emplace_back(x, y, z);
+        std::vector<Lists> lists(blocks.size());
+        std::atomic<std::uint64_t> surfaceLeaves{0};
+        parallelForWithProgress(blocks.size(), progress_.stage(BakeStage::Classifying, 0.0, split),
+                                [&](std::size_t index, const std::atomic<bool>&) {
+                                    std::uint64_t count = 0;
+                                    classifyBlock(blocks[index], kTopBlockSize, lists[index], count);
+                                    evaluated_ += count;
+                                    progress_.countEvaluations(count);
+                                    // Refuse early: the surface leaves alone already exceed the limit.
+                                    const std::uint64_t total = surfaceLeaves += lists[index].surface.size();
+                                    if (estimateFor(total) > limit_) checkMemory(total, false);
+                                });
+        std::vector<Coord> wave;
+        std::vector<Coord> deferred;
+        for (const Lists& list : lists) {
+            for (const Coord& origin : list.surface) {
+                states_.setValue(leafKey(origin), kSurface);
+                wave.push_back(origin);
+            }
+            for (const Coord& origin : list.deferred) {
+                states_.setValue(leafKey(origin), kDeferred);
+                deferred.push_back(origin);
+            }
+        }
+        // A deferred leaf next to skipped space touches outside values there: sample it.
+        const std::vector<Coord> offsets = neighbourOffsets();
+        for (const Coord& origin : deferred) {
+            const Coord key = leafKey(origin);
+            for (const Coord& offset : offsets) {
+                if (states_.getValue(key + offset) != kSkipped) continue;
+                states_.setValue(key, kQueued);
+                wave.push_back(origin);
+                break;
+            }
+        }
+        checkMemory(wave.size(), true);
+        return wave;
+    }
+
+    /// Is the block (grown by one voxel) proven to hold no surface? True when it lies outside
+    /// the bounds, or when boundBall proves every point escapes with a 3-D DE above eps. Counts
+    /// the evaluation and reports whether the block's centre is inside the set (and the bounds).
+    bool provenEmpty(const Coord& origin, int size, std::uint64_t& evaluations, bool* centreInside = nullptr) const {
+        const glm::dvec3 centre = (glm::dvec3(origin.x(), origin.y(), origin.z()) + 0.5 * (size - 1)) * h_;
+        const double radius = 0.5 * (size + 1) * h_ * std::sqrt(3.0);
+        const double regionDistance = f_.region().signedDistance(centre);
+        if (regionDistance > radius) return true;  // wholly outside the bounds: f = distance > 0
+        ++evaluations;
+        const BallBound bound =
+            boundBall(f_.fractal(), f_.slice().map(centre), radius * f_.stretchA(), radius * f_.stretchB());
+        if (centreInside) *centreInside = regionDistance < 0.0 && bound.centre.n == 0;
+        return bound.allEscape && bound.minDe / f_.stretch() > f_.epsilon();
+    }
+
+    /// Skips a block, splits it, or files it as a leaf to sample or to defer.
+    void classifyBlock(const Coord& origin, int size, Lists& lists, std::uint64_t& evaluations) const {
+        if (!indexBox_.hasOverlap(CoordBBox(origin, origin.offsetBy(size - 1)))) return;
+        bool centreInside = false;
+        if (provenEmpty(origin, size, evaluations, &centreInside)) return;
+        if (size == kLeafSize) {
+            (centreInside ? lists.deferred : lists.surface).push_back(origin);
+            return;
+        }
+        const int half = size / 2;
+        for (int x = 0; x < 2; ++x)
+            for (int y = 0; y < 2; ++y)
+                for (int z = 0; z < 2; ++z) classifyBlock(origin.offsetBy(x * half, y * half, z * half), half, lists, evaluations);
+    }
+
+    /// Samples leaves in parallel, one task a leaf. A leaf's 4^3 quarters are tested first, and
+    /// a proven quarter keeps the (positive) background: no surface cell touches it.
+    std::vector<std::unique_ptr<FloatLeaf>> sampleLeaves(const std::vector<Coord>& origins, const ProgressCallback& progress) {
+        std::vector<std::unique_ptr<FloatLeaf>> leaves(origins.size());
+        constexpr int kQuarter = kLeafSize / 2;
+        parallelForWithProgress(origins.size(), progress, [&](std::size_t index, const std::atomic<bool>& stop) {
+            auto leaf = std::make_unique<FloatLeaf>(origins[index], f_.background(), false);
+            std::uint64_t count = 0;
+            for (int quarter = 0; quarter < 8; ++quarter) {
+                if (stop.load(std::memory_order_relaxed)) return;
+                const Coord corner((quarter & 1) * kQuarter, ((quarter >> 1) & 1) * kQuarter, ((quarter >> 2) & 1) * kQuarter);
+                if (!options_.dense && provenEmpty(leaf->origin() + corner, kQuarter, count)) continue;
+                for (int x = 0; x < kQuarter; ++x)
+                    for (int y = 0; y < kQuarter; ++y)
+                        for (int z = 0; z < kQuarter; ++z) {
+                            const openvdb::Index offset = FloatLeaf::coordToOffset(corner.offsetBy(x, y, z));
+                            leaf->setValueOn(offset, f_(voxelCentre(leaf->offsetToGlobalCoord(offset), h_), count));
+                        }
+            }
+            evaluated_ += count;
+            progress_.countEvaluations(count);
+            leaves[index] = std::move(leaf);
+        });
+        return leaves;
+    }
+
+    std::uint64_t estimateFor(std::uint64_t leaves) const {
+        const double perLeaf = options_.dense ? kFloatLeafBytes : kFloatLeafBytes + memory_.bytesPerLeaf;
+        return std::uint64_t(memory_.fixedBytes + perLeaf * double(leaves));
+    }
+
+    /// Refuses (MemoryLimitError) when `leaves` sampled leaves would exceed the limit. `final`:
+    /// the whole count after classification; otherwise a count still growing during it.
+    void checkMemory(std::uint64_t leaves, bool final) {
+        const std::uint64_t estimate = estimateFor(leaves);
+        if (final) stats_.estimatedBytes = estimate;
+        if (estimate <= limit_) return;
+        const std::string limit = formatBytes(limit_) + (options_.memoryLimit ? "" : " (half of the available memory)");
+        const std::string blocks = std::to_string(leaves) + " blocks of 8^3 voxels to sample";
+        throw MemoryLimitError("resolution " + std::to_string(params_.bake.resolution) +
+                                   (final ? " needs an estimated " + formatBytes(estimate) + " (" + blocks + "), more than the limit of " + limit
+                                          : " needs more than the limit of " + limit + ": the first " + blocks + " already need " +
+                                                formatBytes(estimate)) +
+                                   "; lower the resolution, bake a smaller region (bake.bounds) or raise the limit (--max-memory)",
+                               estimate, limit_);
+    }
+
+    const Params& params_;
+    const BakeOptions& options_;
+    MemoryModel memory_;
+    StagedProgress& progress_;
+    SurfaceFunction f_;
+    double h_;
+    Coord lo_, hi_;
+    CoordBBox indexBox_;
+    std::uint64_t dense_ = 1;
+    std::uint64_t limit_ = 0;
+    std::atomic<std::uint64_t> evaluated_{0};
+    openvdb::Int32Tree states_{kSkipped};  // keyed by leaf (origin / 8)
+    BakeStats stats_;
+};
+
+}  // namespace
+
+BakeRegion::BakeRegion(const Params& params) {
+    if (params.bake.bounds) {
+        sphere_ = false;
+        box_ = *params.bake.bounds;
+        return;
+    }
+    bounds_ = renderBounds(params);
+    box_.min = bounds_.center - bounds_.radius;
+    box_.max = bounds_.center + bounds_.radius;
+}
+
+double BakeRegion::signedDistance(const glm::dvec3& p) const {
+    if (sphere_) return glm::length(p - bounds_.center) - bounds_.radius;
+    const glm::dvec3 centre = 0.5 * (box_.min + box_.max);
+    const glm::dvec3 q = glm::abs(p - centre) - 0.5 * (box_.max - box_.min);
+    const double outside = glm::length(glm::max(q, glm::dvec3(0.0)));
+    const double inside = std::min(std::max(q.x, std::max(q.y, q.z)), 0.0);
+    return outside + inside;
+}
+
+SurfaceFunction::SurfaceFunction(const Params& params, double voxelSize)
+    : fractal_(params.fractal),
+      slice_(params.slice.effective()),
+      region_(params),
+      voxelSize_(voxelSize),
+      epsilon_(0.25 * voxelSize),
+      background_(float((params.bake.bandWidth + 1.0) * voxelSize)) {
+    stretch_ = stretchOf(slice_).max;
+    stretchA_ = largestStretch(slice_, true, false);
+    stretchB_ = largestStretch(slice_, false, true);
+}
+
+float SurfaceFunction::operator()(const glm::dvec3& p, std::uint64_t& evaluations) const {
+    const double limit = background_;
+    const double regionDistance = region_.signedDistance(p);
+    if (regionDistance > 0.0) return float(std::min(regionDistance, limit));
+    ++evaluations;
+    const Escape escape = evaluate(fractal_, slice_.map(p));
+    // DE = +inf (an orbit from the critical point) carries no distance: the clamp takes it.
+    const double value = escape.n == 0 ? -epsilon_ : std::min(escape.de / stretch_, limit) - epsilon_;
+    return float(std::clamp(std::max(value, regionDistance), -limit, limit));
+}
+
+double bakeVoxelSize(const Params& params) {
+    const BakeRegion region(params);
+    const glm::dvec3 size = region.box().max - region.box().min;
+    return std::max(size.x, std::max(size.y, size.z)) / params.bake.resolution;
+}
+
+SampledSurface sampleSurface(const Params& params, const BakeOptions& options, const MemoryModel& memory,
+                             StagedProgress& progress, double split, double end) {
+    Sampler sampler(params, options, memory, progress);
+    return sampler.run(split, end);
+}
+
+}  // namespace dqj

@@ -1,0 +1,35 @@
+# One Blender test: makes a file with the real dqjulia, then checks it in the real Blender.
+#   cmake -DCLI=dqjulia -DBLENDER=blender -DSCRIPTS=tests/blender -DWORK=folder -DEXAMPLES=examples
+#         -DMODE=vdb|sequence|ply|obj -P blender_test.cmake
+# The dqjulia run uses small resolutions so the whole check takes seconds.
+file(REMOVE_RECURSE "${WORK}")
+file(MAKE_DIRECTORY "${WORK}")
+
+function(run)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE status OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT status EQUAL 0)
+    message(FATAL_ERROR "failed (${status}): ${ARGN}\n${out}\n${err}")
+  endif()
+  set(out "${out}" PARENT_SCOPE)
+endfunction()
+
+set(blender ${BLENDER} -b --factory-startup --python-exit-code 1 --python)
+if(MODE STREQUAL "vdb")
+  run(${CLI} bake -q -r 32 --grids surface,density,color,trap,iterations -o ${WORK}/fractal.vdb)
+  run(${blender} ${SCRIPTS}/check_vdb.py -- ${WORK}/fractal.vdb surface,density,color,trap,iterations)
+elseif(MODE STREQUAL "sequence")
+  run(${CLI} bake -q -r 24 -p ${EXAMPLES}/animation.json --frames 1-3 -o ${WORK}/seq.vdb)
+  run(${blender} ${SCRIPTS}/check_vdb.py -- --sequence ${WORK}/seq_0001.vdb 3 surface,density)
+else()
+  run(${CLI} mesh -q -r 32 --stats -o ${WORK}/fractal.${MODE})
+  string(REGEX MATCH "vertices ([0-9]+)" _ "${out}")
+  set(vertices ${CMAKE_MATCH_1})
+  string(REGEX MATCH "faces ([0-9]+)" _ "${out}")
+  set(faces ${CMAKE_MATCH_1})
+  if(NOT vertices OR NOT faces)
+    message(FATAL_ERROR "dqjulia mesh --stats printed no counts:\n${out}")
+  endif()
+  run(${blender} ${SCRIPTS}/check_mesh.py -- ${WORK}/fractal.${MODE} ${vertices} ${faces})
+endif()
+message(STATUS "${out}")
+file(REMOVE_RECURSE "${WORK}")
