@@ -85,13 +85,13 @@ TEST_P(Interrupt, StopsARenderPromptlyAndKeepsThePreviousOutput) {
     const pid_t pid = spawnCli({"render", "--force", "-W", "1600", "-H", "1200", "-s", "4", "-o", output.string()},
                                dir_ / "stderr.txt");
     ASSERT_GT(pid, 0);
-    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    std::this_thread::sleep_for(std::chrono::milliseconds(1000));  // well past start-up, even under sanitizers
     const auto sent = std::chrono::steady_clock::now();
     ASSERT_EQ(::kill(pid, GetParam()), 0);
     const int exitCode = waitExit(pid);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
     EXPECT_EQ(exitCode, 130) << readFile(dir_ / "stderr.txt");
-    EXPECT_LT(seconds, 2.0) << "the render did not stop promptly";
+    EXPECT_LT(seconds, 5.0) << "the render did not stop promptly";  // ~0.1 s when idle; generous for loaded CI
     EXPECT_NE(readFile(dir_ / "stderr.txt").find("interrupted; nothing was written"), std::string::npos);
     EXPECT_EQ(readFile(output), "previous picture");
     EXPECT_EQ(filesIn(dir_).size(), 2u);  // picture.png and stderr.txt only
