@@ -1,4 +1,5 @@
 // dqjulia povray: write a POV-Ray scene that draws what `dqjulia render` draws (and a DF3 grid).
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -74,8 +75,11 @@ int runPovray(const PovrayOptions& options) {
     progress.finish();
     if (!options.quiet) {
         for (const std::string& path : written) std::cerr << "wrote " << path << "\n";
-        const std::string scene = files.scene.empty() ? files.df3Scene : files.scene;
-        std::cerr << "render with: " << povrayCommand(params, scene)
+        // POV-Ray looks for the include and the DF3 file in the folder it runs in and on its
+        // library path, not beside the scene: run it in the scene's folder.
+        const std::filesystem::path scene(files.scene.empty() ? files.df3Scene : files.scene);
+        std::cerr << "render with: " << (scene.has_parent_path() ? "cd '" + scene.parent_path().string() + "' && " : "")
+                  << povrayCommand(params, scene.filename().string())
                   << (write.copyInclude ? "" : " +L<dqjulia>/povray") << "\n";
     }
     return kSuccess;
@@ -101,7 +105,7 @@ Runner addPovrayCommand(CLI::App& app) {
                       "Also bake <scene>.df3 (the distance estimate on a grid) and <scene>_df3.pov drawing it: fast\n"
                       "renders of heavy settings, at the grid's resolution");
     command->add_option("--df3-resolution", options->df3Resolution, "Samples per axis of the DF3 grid")
-        ->check(CLI::Range(2, 1024));
+        ->check(CLI::Range(2, 512));
     command->add_option("--df3-bits", options->df3Bits, "Bits per DF3 sample: 8, 16 or 32")
         ->check(CLI::IsMember({8, 16, 32}));
     command->add_flag("--no-include", options->noInclude,

@@ -1,5 +1,6 @@
 // Baking to OpenVDB (bake.hpp): the level set, the fog volume, the attribute grids and the file.
 #include "dqjulia/bake.hpp"
+#include "dqjulia/batch.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -89,12 +90,17 @@ void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, 
         auto colorLeaf = color ? std::make_unique<ColorLeaf>(leaf.origin(), openvdb::Vec3s(0.0f), false) : nullptr;
         auto trapLeaf = trap ? std::make_unique<FloatLeaf>(leaf.origin(), 0.0f, false) : nullptr;
         auto iterationLeaf = iterations ? std::make_unique<FloatLeaf>(leaf.origin(), 0.0f, false) : nullptr;
+        if (stop.load(std::memory_order_relaxed)) return;
+        thread_local BatchBuffer<double> batch;  // the leaf's active voxels through the SIMD kernel together
+        batch.clear();
+        for (auto voxel = leaf.cbeginValueOn(); voxel; ++voxel) {
+            const openvdb::Coord ijk = voxel.getCoord();
+            batch.add(slice.map(glm::dvec3(ijk.x(), ijk.y(), ijk.z()) * h));
+        }
+        batch.evaluate(params.fractal);
         std::uint64_t count = 0;
         for (auto voxel = leaf.cbeginValueOn(); voxel; ++voxel) {
-            if (count % 64 == 0 && stop.load(std::memory_order_relaxed)) return;
-            const openvdb::Coord ijk = voxel.getCoord();
-            const Escape escape = evaluate(params.fractal, slice.map(glm::dvec3(ijk.x(), ijk.y(), ijk.z()) * h));
-            ++count;
+            const Escape escape = batch.escape(count++);
             if (colorLeaf) {
                 const glm::dvec3 rgb = orbitColour(params.material, params.fractal, escape);
                 colorLeaf->setValueOn(voxel.pos(), openvdb::Vec3s(float(rgb.x), float(rgb.y), float(rgb.z)));

@@ -14,6 +14,7 @@
 #include <openvdb/tools/VolumeToMesh.h>
 
 #include "atomic_file.hpp"
+#include "dqjulia/batch.hpp"
 #include "dqjulia/image.hpp"
 #include "dqjulia/render.hpp"
 #include "level_set.hpp"
@@ -227,11 +228,14 @@ Mesh bakeMesh(const Params& params, const BakeOptions& options, const ProgressCa
         const Slice slice = params.slice.effective();
         const std::size_t tasks = (mesh.positions.size() + kVerticesPerTask - 1) / kVerticesPerTask;
         parallelForWithProgress(tasks, staged.stage(BakeStage::Meshing, 0.9, 1.0), [&](std::size_t task, const std::atomic<bool>&) {
+            const std::size_t first = task * kVerticesPerTask;
             const std::size_t end = std::min(mesh.positions.size(), (task + 1) * kVerticesPerTask);
-            for (std::size_t index = task * kVerticesPerTask; index < end; ++index) {
-                const Escape escape = evaluate(params.fractal, slice.map(glm::dvec3(mesh.positions[index])));
-                mesh.colors[index] = glm::vec3(orbitColour(params.material, params.fractal, escape));
-            }
+            thread_local BatchBuffer<double> batch;  // the task's vertices through the SIMD kernel together
+            batch.clear();
+            for (std::size_t index = first; index < end; ++index) batch.add(slice.map(glm::dvec3(mesh.positions[index])));
+            batch.evaluate(params.fractal);
+            for (std::size_t index = first; index < end; ++index)
+                mesh.colors[index] = glm::vec3(orbitColour(params.material, params.fractal, batch.escape(index - first)));
         });
         stats.evaluated += mesh.positions.size();
     } else if (progress && !progress(1.0)) {

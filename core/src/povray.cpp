@@ -375,8 +375,8 @@ std::string povrayCommand(const Params& params, const std::string& scene) {
 std::string povrayScene(const Params& params, const PovraySceneOptions& options) { return buildScene(params, options); }
 
 DensityGrid bakeDensityGrid(const Params& params, int resolution, const ProgressCallback& progress) {
-    if (resolution < 2 || resolution > 1024)
-        throw ParamError("df3.resolution", "the density grid's resolution must be from 2 to 1024 samples per axis, got " +
+    if (resolution < 2 || resolution > 512)
+        throw ParamError("df3.resolution", "the density grid's resolution must be from 2 to 512 samples per axis, got " +
                                                std::to_string(resolution));
     const SceneFacts facts = resolve(params);
     DensityGrid grid;

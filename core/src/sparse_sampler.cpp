@@ -11,6 +11,7 @@
 #include <glm/geometric.hpp>
 
 #include "dqjulia/ball_bound.hpp"
+#include "dqjulia/batch.hpp"
 #include "dqjulia/render.hpp"
 #include "parallel_progress.hpp"
 
@@ -248,6 +249,10 @@ private:
         parallelForWithProgress(origins.size(), progress, [&](std::size_t index, const std::atomic<bool>& stop) {
             auto leaf = std::make_unique<FloatLeaf>(origins[index], f_.background(), false);
             std::uint64_t count = 0;
+            openvdb::Index offsets[FloatLeaf::SIZE];
+            glm::dvec3 centres[FloatLeaf::SIZE];
+            float values[FloatLeaf::SIZE];
+            std::size_t voxels = 0;
             for (int quarter = 0; quarter < 8; ++quarter) {
                 if (stop.load(std::memory_order_relaxed)) return;
                 const Coord corner((quarter & 1) * kQuarter, ((quarter >> 1) & 1) * kQuarter, ((quarter >> 2) & 1) * kQuarter);
@@ -256,9 +261,13 @@ private:
                     for (int y = 0; y < kQuarter; ++y)
                         for (int z = 0; z < kQuarter; ++z) {
                             const openvdb::Index offset = FloatLeaf::coordToOffset(corner.offsetBy(x, y, z));
-                            leaf->setValueOn(offset, f_(voxelCentre(leaf->offsetToGlobalCoord(offset), h_), count));
+                            offsets[voxels] = offset;
+                            centres[voxels++] = voxelCentre(leaf->offsetToGlobalCoord(offset), h_);
                         }
             }
+            // The leaf's voxels through the SIMD batch kernel together.
+            f_(centres, voxels, values, count);
+            for (std::size_t voxel = 0; voxel < voxels; ++voxel) leaf->setValueOn(offsets[voxel], values[voxel]);
             evaluated_ += count;
             progress_.countEvaluations(count);
             leaves[index] = std::move(leaf);
@@ -342,9 +351,37 @@ float SurfaceFunction::operator()(const glm::dvec3& p, std::uint64_t& evaluation
     if (regionDistance > 0.0) return float(std::min(regionDistance, limit));
     ++evaluations;
     const Escape escape = evaluate(fractal_, slice_.map(p));
+    return value(escape.n, escape.de, regionDistance);
+}
+
+float SurfaceFunction::value(int n, double de, double regionDistance) const {
+    const double limit = background_;
     // DE = +inf (an orbit from the critical point) carries no distance: the clamp takes it.
-    const double value = escape.n == 0 ? -epsilon_ : std::min(escape.de / stretch_, limit) - epsilon_;
-    return float(std::clamp(std::max(value, regionDistance), -limit, limit));
+    const double inner = n == 0 ? -epsilon_ : std::min(de / stretch_, limit) - epsilon_;
+    return float(std::clamp(std::max(inner, regionDistance), -limit, limit));
+}
+
+void SurfaceFunction::operator()(const glm::dvec3* points, std::size_t count, float* values,
+                                 std::uint64_t& evaluations) const {
+    thread_local BatchBuffer<double> batch;
+    thread_local std::vector<std::size_t> evaluated;  // indices of the points inside the region
+    batch.clear();
+    evaluated.clear();
+    for (std::size_t i = 0; i < count; ++i) {
+        const double regionDistance = region_.signedDistance(points[i]);
+        if (regionDistance > 0.0) {
+            values[i] = float(std::min(regionDistance, double(background_)));
+        } else {
+            batch.add(slice_.map(points[i]));
+            evaluated.push_back(i);
+        }
+    }
+    batch.evaluate(fractal_);
+    evaluations += evaluated.size();
+    for (std::size_t k = 0; k < evaluated.size(); ++k) {
+        const std::size_t i = evaluated[k];
+        values[i] = value(batch.n(k), batch.de(k), region_.signedDistance(points[i]));
+    }
 }
 
 double bakeVoxelSize(const Params& params) {

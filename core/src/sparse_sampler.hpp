@@ -50,6 +50,9 @@ public:
     SurfaceFunction(const Params& params, double voxelSize);
     /// f at slice point p; adds 1 to `evaluations` when the fractal was evaluated.
     float operator()(const glm::dvec3& p, std::uint64_t& evaluations) const;
+    /// f at `count` points at once, the fractal evaluated by the SIMD batch kernel (batch.hpp):
+    /// the values of operator() (the kernel's DE differs from evaluate()'s in its last bits).
+    void operator()(const glm::dvec3* points, std::size_t count, float* values, std::uint64_t& evaluations) const;
 
     const Fractal& fractal() const { return fractal_; }
     const Slice& slice() const { return slice_; }
@@ -62,6 +65,8 @@ public:
     float background() const { return background_; } ///< (band width + 1) * h
 
 private:
+    float value(int n, double de, double regionDistance) const;  ///< f from an escape count and DE
+
     Fractal fractal_;
     Slice slice_;
     BakeRegion region_;

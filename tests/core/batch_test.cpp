@@ -264,6 +264,31 @@ TEST(BatchDouble, EveryCountAndTail) {
     }
 }
 
+// Huge, infinite and NaN starts: the kernel follows evaluate() through overflow, NaN included
+// (std::min/std::max semantics for the trap, the paper's r and its DE).
+TEST(BatchDouble, ExtremeStartsMatchIncludingInfinitiesAndNaN) {
+    const double inf = std::numeric_limits<double>::infinity();
+    const double values[] = {1e300, 1e160, -1e200, inf, -inf, std::nan(""), 0.0, -0.0, 3.0, 1e-320};
+    std::vector<DualQuat> points;
+    for (const double x : values) points.push_back(DualQuat{makeQuat(x, 0.1, 0.0, 0.0), makeQuat(0.2, x, 0.0, 0.0)});
+    auto same = [](double a, double b) { return a == b || (std::isnan(a) && std::isnan(b)); };
+    for (const BatchTarget& target : batchTargets()) {
+        for (const Variant variant : kVariants) {
+            const Fractal fractal = makeFractal(kC2, variant, 15);
+            const Results<double> got = runBatch<double>(fractal, points, target.id);
+            for (std::size_t i = 0; i < points.size(); ++i) {
+                const Escape want = evaluate(fractal, points[i]);
+                EXPECT_EQ(got.n[i], want.n) << target.name << " " << describe(fractal) << " x = " << values[i];
+                EXPECT_TRUE(same(got.r[i], want.r) && same(got.ra[i], want.ra) && same(got.rb[i], want.rb) &&
+                            same(got.trap[i], want.trap) &&
+                            (same(got.de[i], want.de) || sameDistance(want.de, got.de[i], 1e-12)))
+                    << target.name << " " << describe(fractal) << " x = " << values[i] << ": r " << got.r[i] << " vs "
+                    << want.r << ", de " << got.de[i] << " vs " << want.de << ", trap " << got.trap[i] << " vs " << want.trap;
+            }
+        }
+    }
+}
+
 TEST(BatchBuffer, AddEvaluateAndReadBack) {
     const Fractal fractal = makeFractal(kC1, Variant::Paper, 15);
     BatchBuffer<double> buffer;

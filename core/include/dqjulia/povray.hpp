@@ -45,7 +45,7 @@ struct DensityGrid {
 
 /// Samples the parameter set's distance estimate on a resolution^3 grid over the cube around
 /// the render bounds. Throws ParamError for invalid parameters or a resolution outside
-/// [2, 1024], Cancelled if `progress` returned false.
+/// [2, 512] (a 512^3 grid holds 134 million samples), Cancelled if `progress` returned false.
 DQJ_API DensityGrid bakeDensityGrid(const Params& params, int resolution, const ProgressCallback& progress = {});
 
 /// Writes a DF3 file: three big-endian 16-bit sizes, then the samples as big-endian unsigned
