@@ -292,7 +292,7 @@ def has_subcommand(dqjulia, name):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    parser.add_argument("--build", default=os.path.join(root, "build-speed"), help="dqjulia build folder")
+    parser.add_argument("--build", default=os.path.join(root, "build-bench"), help="dqjulia build folder")
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--skip-mesh", action="store_true")
     parser.add_argument("--skip-bake", action="store_true")
@@ -304,7 +304,7 @@ def main():
 
     dqjulia = os.path.join(args.build, "bin", "dqjulia")
     if not os.access(dqjulia, os.X_OK):
-        sys.exit(f"{dqjulia} not found: build first (cmake -S . -B {args.build} -DDQJ_BUILD_BENCH=ON && cmake --build {args.build} -j)")
+        sys.exit(f"{dqjulia} not found: build first (bench/run.sh does)")
     work = args.keep or tempfile.mkdtemp(prefix="dqjulia_compare_")
     os.makedirs(work, exist_ok=True)
     params = os.path.join(work, "quaternion_julia.json")

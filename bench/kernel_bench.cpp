@@ -17,7 +17,7 @@
 // "cpu MHz" of /proc/cpuinfo), for one core. CPUs that execute 512-bit FMAs as two 256-bit
 // halves (AMD Zen 4) have half that peak for AVX-512; the summary says which it assumed.
 //
-// Run: build-speed/bin/dqjulia_bench  (Google Benchmark flags work, e.g. --benchmark_filter=dual)
+// Run: build-bench/bin/dqjulia_bench (bench/run.sh builds it)  (Google Benchmark flags work, e.g. --benchmark_filter=dual)
 #include <benchmark/benchmark.h>
 
 #include <cstdio>

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Installs the Debian packages dqjulia needs to build and test, if any are missing.
-# Usage: scripts/install-deps.sh   (as root, or with sudo available)
+# Usage: scripts/install-deps.sh [MORE PACKAGES...]   (as root, or with sudo available)
+# bench/run.sh passes the benchmark comparisons' packages as arguments.
 set -euo pipefail
 
 packages=(
@@ -11,6 +12,7 @@ packages=(
   xvfb xauth glslang-tools  # the add-on's preview in a real Blender window (xvfb-run); its GLSL checked
   povray  # tests/povray evaluate dqjulia.inc and render generated scenes in the real POV-Ray 3.7
 )
+packages+=("$@")
 
 missing=()
 for package in "${packages[@]}"; do
