@@ -79,6 +79,19 @@ def _library_ready(operator):
     return True
 
 
+def _read_params(operator, context, path, done_message):
+    """Reads a parameter file into the active DQ Julia object; a bad file is reported, not raised."""
+    if not _library_ready(operator):
+        return {"CANCELLED"}
+    try:
+        load_params_into(dqjulia_object(context), path)
+    except (native.NativeError, OSError) as error:
+        operator.report({"ERROR"}, str(error))
+        return {"CANCELLED"}
+    operator.report({"INFO"}, done_message)
+    return {"FINISHED"}
+
+
 class DQJULIA_OT_add(bpy.types.Operator):
     """Add a DQ Julia object: the set ray-marched in the viewport inside its bounds"""
     bl_idname = "object.dqjulia_add"
@@ -131,16 +144,8 @@ class DQJULIA_OT_load_preset(bpy.types.Operator):
         return dqjulia_object(context) is not None
 
     def execute(self, context):
-        if not _library_ready(self):
-            return {"CANCELLED"}
-        obj = dqjulia_object(context)
-        try:
-            load_params_into(obj, os.path.join(PRESET_DIR, self.preset + ".json"))
-        except (native.NativeError, OSError) as error:
-            self.report({"ERROR"}, str(error))
-            return {"CANCELLED"}
-        self.report({"INFO"}, "Loaded preset %s" % self.preset)
-        return {"FINISHED"}
+        return _read_params(self, context, os.path.join(PRESET_DIR, self.preset + ".json"),
+                            "Loaded preset %s" % self.preset)
 
 
 class DQJULIA_OT_import_params(bpy.types.Operator, ImportHelper):
@@ -157,15 +162,7 @@ class DQJULIA_OT_import_params(bpy.types.Operator, ImportHelper):
         return dqjulia_object(context) is not None
 
     def execute(self, context):
-        if not _library_ready(self):
-            return {"CANCELLED"}
-        try:
-            load_params_into(dqjulia_object(context), self.filepath)
-        except (native.NativeError, OSError) as error:
-            self.report({"ERROR"}, str(error))
-            return {"CANCELLED"}
-        self.report({"INFO"}, "Read %s" % self.filepath)
-        return {"FINISHED"}
+        return _read_params(self, context, self.filepath, "Read %s" % self.filepath)
 
 
 class DQJULIA_OT_export_params(bpy.types.Operator, ExportHelper):

@@ -1,6 +1,7 @@
 // Temporary file + rename (see atomic_file.hpp). POSIX only: mkstemp, fsync, rename.
 #include "atomic_file.hpp"
 
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -79,6 +80,12 @@ void AtomicFile::commit() {
         ::fsync(folderFd);
         ::close(folderFd);
     }
+}
+
+std::string AtomicFile::lowercaseExtension(const std::string& path) {
+    std::string extension = std::filesystem::path(path).extension().string();
+    for (char& ch : extension) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    return extension;
 }
 
 }  // namespace dqj

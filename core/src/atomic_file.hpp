@@ -35,6 +35,8 @@ public:
 
     /// "cannot write 'path': reason" - the message writers use for their own failures too.
     static std::string failureMessage(const std::string& path, const std::string& reason);
+    /// The extension of a path's file name in lower case, with its dot (".vdb"), or "".
+    static std::string lowercaseExtension(const std::string& path);
 
 private:
     std::string path_;

@@ -60,15 +60,6 @@ double smoothIterations(const Fractal& fractal, const Escape& escape) {
     return escape.n + 1.0 - std::log2(std::log(escape.r) / std::log(fractal.bailout));
 }
 
-std::string extensionOf(const std::string& path) {
-    const std::size_t slash = path.find_last_of('/');
-    const std::size_t dot = path.rfind('.');
-    if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
-    std::string extension = path.substr(dot);
-    std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char ch) { return std::tolower(ch); });
-    return extension;
-}
-
 /// The attribute grids ("color", "trap", "iterations") on the level set's active voxels: one
 /// fractal evaluation per voxel of the narrow band.
 void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, const ProgressCallback& progress,
@@ -198,7 +189,7 @@ std::string_view bakeStageName(BakeStage stage) {
 BakeStats bakeVdb(const Params& params, const std::string& path, const BakeOptions& options, const ProgressCallback& progress) {
     const auto start = std::chrono::steady_clock::now();
     validate(params);
-    if (extensionOf(path) != ".vdb") throw ParamError("output.path", "'" + path + "' must end in .vdb");
+    if (AtomicFile::lowercaseExtension(path) != ".vdb") throw ParamError("output.path", "'" + path + "' must end in .vdb");
     AtomicFile file(path);  // fails now, before the work, if the folder is not writable
     StagedProgress staged(progress, options.monitor);
     BakeStats stats;

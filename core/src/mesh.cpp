@@ -35,15 +35,6 @@ MemoryModel meshMemoryModel() {
     return model;
 }
 
-std::string extensionOf(const std::string& path) {
-    const std::size_t slash = path.find_last_of('/');
-    const std::size_t dot = path.rfind('.');
-    if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
-    std::string extension = path.substr(dot);
-    std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char ch) { return std::tolower(ch); });
-    return extension;
-}
-
 /// Drops faces with fewer than three distinct vertices and turns quads with one repeated vertex
 /// into triangles (adaptive meshing collapses vertices), then drops unused vertices.
 void removeDegenerateFaces(std::vector<openvdb::Vec3s>& points, std::vector<openvdb::Vec3I>& triangles,
@@ -247,7 +238,7 @@ Mesh bakeMesh(const Params& params, const BakeOptions& options, const ProgressCa
 }
 
 void writeMesh(const Mesh& mesh, const std::string& path) {
-    const std::string extension = extensionOf(path);
+    const std::string extension = AtomicFile::lowercaseExtension(path);
     if (extension != ".ply" && extension != ".obj")
         throw ParamError("output.path", "'" + path + "' must end in .ply or .obj");
     AtomicFile file(path);
