@@ -16,6 +16,7 @@
 #include <string>
 #include <thread>
 #include <vector>
+#include "test_folder.hpp"
 
 extern char** environ;
 namespace fs = std::filesystem;
@@ -37,12 +38,7 @@ struct Outcome {
 
 class BakeCli : public ::testing::Test {
 protected:
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() / ("dqjulia_bake_cli_" + std::to_string(::getpid()) + "_" +
-                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
+    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_bake_cli"); }
     void TearDown() override { fs::remove_all(dir_); }
 
     Outcome run(const std::string& arguments) {

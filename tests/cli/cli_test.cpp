@@ -11,6 +11,7 @@
 #include <string>
 
 #include "dqjulia/image.hpp"
+#include "test_folder.hpp"
 
 namespace fs = std::filesystem;
 
@@ -31,12 +32,7 @@ std::string readFile(const fs::path& path) {
 
 class Cli : public ::testing::Test {
 protected:
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() / ("dqjulia_cli_" + std::to_string(::getpid()) + "_" +
-                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
+    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_cli"); }
     void TearDown() override { fs::remove_all(dir_); }
 
     /// Runs `dqjulia <arguments>` with `input` on stdin.

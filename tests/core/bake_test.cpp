@@ -22,6 +22,7 @@
 #include "dqjulia/dqjulia.h"
 #include "dqjulia/mesh.hpp"
 #include "dqjulia/params.hpp"
+#include "test_folder.hpp"
 
 namespace fs = std::filesystem;
 using namespace dqj;
@@ -31,12 +32,7 @@ namespace {
 class Bake : public ::testing::Test {
 protected:
     static void SetUpTestSuite() { openvdb::initialize(); }
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() / ("dqjulia_bake_" + std::to_string(::getpid()) + "_" +
-                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
+    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_bake"); }
     void TearDown() override { fs::remove_all(dir_); }
     std::string path(const std::string& name) const { return (dir_ / name).string(); }
     std::vector<std::string> files() const {

@@ -19,6 +19,7 @@
 
 #include "dqjulia/image.hpp"
 #include "dqjulia/render.hpp"
+#include "test_folder.hpp"
 
 namespace fs = std::filesystem;
 using namespace dqj;
@@ -64,11 +65,7 @@ double encodeSrgb(double linear) {
 class TempFolder {
 public:
     TempFolder() {
-        path_ = fs::temp_directory_path() /
-                ("dqjulia_render_test_" + std::to_string(::getpid()) + "_" +
-                 ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(path_);
-        fs::create_directories(path_);
+        path_ = dqj::test::freshTestFolder("dqjulia_render_test");
     }
     ~TempFolder() { fs::remove_all(path_); }
     const fs::path& path() const { return path_; }

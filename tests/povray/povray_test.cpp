@@ -23,6 +23,7 @@
 #include "dqjulia/image.hpp"
 #include "dqjulia/povray.hpp"
 #include "dqjulia/render.hpp"
+#include "test_folder.hpp"
 
 namespace fs = std::filesystem;
 
@@ -84,12 +85,7 @@ const char* kPreamble =
 
 class Povray : public ::testing::Test {
 protected:
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() / ("dqjulia_povray_" + std::to_string(::getpid()) + "_" +
-                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
+    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_povray"); }
     void TearDown() override {
         if (!HasFailure()) fs::remove_all(dir_);
     }

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "dqjulia/dqjulia.h"
+#include "test_folder.hpp"
 
 extern char** environ;
 namespace fs = std::filesystem;
@@ -34,12 +35,7 @@ std::string readFile(const fs::path& path) {
 /// A scratch folder per test.
 class Scratch : public ::testing::Test {
 protected:
-    void SetUp() override {
-        dir_ = fs::temp_directory_path() / ("dqjulia_robust_" + std::to_string(::getpid()) + "_" +
-                                            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
-    }
+    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_robust"); }
     void TearDown() override {
         if (mounted_) ::umount(dir_.c_str());
         fs::remove_all(dir_);
