@@ -302,6 +302,7 @@ def main():
     parser.add_argument("--keep", help="keep the images and meshes in this folder")
     args = parser.parse_args()
 
+    args.build = os.path.abspath(args.build)  # the programs run in the work folder
     dqjulia = os.path.join(args.build, "bin", "dqjulia")
     if not os.access(dqjulia, os.X_OK):
         sys.exit(f"{dqjulia} not found: build first (bench/run.sh does)")

@@ -166,7 +166,8 @@ std::string axisNamesOf(const Slice& slice) {
             }
         }
         if (unit < 0) return "";
-        names += (axis ? "," : "") + axisName(unit);
+        if (axis) names += ",";
+        names += axisName(unit);  // not "," + name: GCC 12 warns falsely (-Wrestrict) on that
     }
     return names;
 }
