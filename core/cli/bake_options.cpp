@@ -185,6 +185,7 @@ void printBakeStats(const BakeStats& stats) {
               << "evaluated_fraction " << (stats.dense ? double(stats.evaluated) / double(stats.dense) : 0.0) << "\n"
               << "sampled_leaves " << stats.sampledLeaves << "\n"
               << "interior_leaves " << stats.interiorLeaves << "\n"
+              << "pruned_leaves " << stats.prunedLeaves << "\n"
               << "active_voxels " << stats.activeVoxels << "\n"
               << "estimated_bytes " << stats.estimatedBytes << "\n"
               << "peak_memory_bytes " << std::uint64_t(usage.ru_maxrss) * 1024 << "\n";

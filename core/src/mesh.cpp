@@ -35,51 +35,75 @@ MemoryModel meshMemoryModel() {
     return model;
 }
 
+/// The distinct corners of a polygon in order (a repeated neighbour collapses), or 0 when the
+/// polygon is pinched (a corner repeated apart from its neighbours).
+int distinctCorners(const std::uint32_t* indices, int count, std::uint32_t* distinct) {
+    int size = 0;
+    for (int corner = 0; corner < count; ++corner) {
+        const std::uint32_t index = indices[corner];
+        if (size > 0 && (distinct[size - 1] == index || (corner == count - 1 && distinct[0] == index))) continue;
+        if (std::find(distinct, distinct + size, index) != distinct + size) return 0;
+        distinct[size++] = index;
+    }
+    return size;
+}
+
 /// Drops faces with fewer than three distinct vertices and turns quads with one repeated vertex
-/// into triangles (adaptive meshing collapses vertices), then drops unused vertices.
-void removeDegenerateFaces(std::vector<openvdb::Vec3s>& points, std::vector<openvdb::Vec3I>& triangles,
-                           std::vector<openvdb::Vec4I>& quads) {
-    std::vector<openvdb::Vec3I> keptTriangles;
-    std::vector<openvdb::Vec4I> keptQuads;
-    auto addPolygon = [&](const std::uint32_t* indices, int count) {
-        std::uint32_t distinct[4];
-        int size = 0;
-        for (int corner = 0; corner < count; ++corner) {
-            const std::uint32_t index = indices[corner];
-            if (size > 0 && (distinct[size - 1] == index || (corner == count - 1 && distinct[0] == index))) continue;
-            if (std::find(distinct, distinct + size, index) != distinct + size) return;  // a pinched polygon: drop it
-            distinct[size++] = index;
-        }
-        if (size == 4) keptQuads.emplace_back(distinct[0], distinct[1], distinct[2], distinct[3]);
-        if (size == 3) keptTriangles.emplace_back(distinct[0], distinct[1], distinct[2]);
-    };
-    for (const openvdb::Vec3I& triangle : triangles) {
-        const std::uint32_t indices[3] = {triangle[0], triangle[1], triangle[2]};
-        addPolygon(indices, 3);
+/// into triangles (adaptive meshing collapses vertices), then drops unused vertices. In place:
+/// a 512^3 mesh is some 40 MB, and copies would add to the peak.
+void removeDegenerateFaces(Mesh& mesh) {
+    std::uint32_t distinct[4];
+    std::size_t kept = 0;
+    for (const auto& triangle : mesh.triangles)
+        if (distinctCorners(triangle.data(), 3, distinct) == 3) mesh.triangles[kept++] = {distinct[0], distinct[1], distinct[2]};
+    mesh.triangles.resize(kept);
+    kept = 0;
+    for (const auto& quad : mesh.quads) {
+        const int size = distinctCorners(quad.data(), 4, distinct);
+        if (size == 4) mesh.quads[kept++] = {distinct[0], distinct[1], distinct[2], distinct[3]};
+        if (size == 3) mesh.triangles.push_back({distinct[0], distinct[1], distinct[2]});
     }
-    for (const openvdb::Vec4I& quad : quads) {
-        const std::uint32_t indices[4] = {quad[0], quad[1], quad[2], quad[3]};
-        addPolygon(indices, 4);
-    }
-    // Renumber the vertices that faces use, in their original order.
-    std::vector<std::uint32_t> renumbered(points.size(), UINT32_MAX);
-    for (const auto& triangle : keptTriangles)
-        for (int corner = 0; corner < 3; ++corner) renumbered[triangle[corner]] = 0;
-    for (const auto& quad : keptQuads)
-        for (int corner = 0; corner < 4; ++corner) renumbered[quad[corner]] = 0;
-    std::vector<openvdb::Vec3s> keptPoints;
-    for (std::size_t index = 0; index < points.size(); ++index) {
+    mesh.quads.resize(kept);
+    // Renumber the vertices that faces use, in their original order (so positions compact in place).
+    std::vector<std::uint32_t> renumbered(mesh.positions.size(), UINT32_MAX);
+    for (const auto& triangle : mesh.triangles)
+        for (const std::uint32_t index : triangle) renumbered[index] = 0;
+    for (const auto& quad : mesh.quads)
+        for (const std::uint32_t index : quad) renumbered[index] = 0;
+    std::uint32_t next = 0;
+    for (std::size_t index = 0; index < mesh.positions.size(); ++index) {
         if (renumbered[index] == UINT32_MAX) continue;
-        renumbered[index] = std::uint32_t(keptPoints.size());
-        keptPoints.push_back(points[index]);
+        renumbered[index] = next;
+        mesh.positions[next++] = mesh.positions[index];
     }
-    for (auto& triangle : keptTriangles)
-        for (int corner = 0; corner < 3; ++corner) triangle[corner] = renumbered[triangle[corner]];
-    for (auto& quad : keptQuads)
-        for (int corner = 0; corner < 4; ++corner) quad[corner] = renumbered[quad[corner]];
-    points = std::move(keptPoints);
-    triangles = std::move(keptTriangles);
-    quads = std::move(keptQuads);
+    mesh.positions.resize(next);
+    for (auto& triangle : mesh.triangles)
+        for (std::uint32_t& index : triangle) index = renumbered[index];
+    for (auto& quad : mesh.quads)
+        for (std::uint32_t& index : quad) index = renumbered[index];
+}
+
+/// Vertex normals: the sum of the cross products of the faces around each vertex (normals
+/// weighted by area; a quad as the triangles 0-1-2 and 0-2-3), normalised. Summed in place, in
+/// float: no per-corner or double-precision copies of the mesh.
+std::vector<glm::vec3> vertexNormals(const Mesh& mesh) {
+    std::vector<glm::vec3> normals(mesh.positions.size(), glm::vec3(0.0f));
+    auto addTriangle = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+        const glm::vec3 normal = glm::cross(mesh.positions[b] - mesh.positions[a], mesh.positions[c] - mesh.positions[a]);
+        normals[a] += normal;
+        normals[b] += normal;
+        normals[c] += normal;
+    };
+    for (const auto& triangle : mesh.triangles) addTriangle(triangle[0], triangle[1], triangle[2]);
+    for (const auto& quad : mesh.quads) {
+        addTriangle(quad[0], quad[1], quad[2]);
+        addTriangle(quad[0], quad[2], quad[3]);
+    }
+    for (glm::vec3& normal : normals) {
+        const float length = glm::length(normal);
+        normal = length > 0.0f ? normal / length : glm::vec3(0.0f);
+    }
+    return normals;
 }
 
 void writePly(const Mesh& mesh, std::ostream& out) {
@@ -179,39 +203,28 @@ Mesh bakeMesh(const Params& params, const BakeOptions& options, const ProgressCa
     SampledSurface sampled = sampleSurface(params, options, meshMemoryModel(), staged, 0.05, 0.8);
     BakeStats stats = sampled.stats;
 
-    std::vector<openvdb::Vec3s> points;
-    std::vector<openvdb::Vec3I> triangles;
-    std::vector<openvdb::Vec4I> quads;
-    parallelForWithProgress(1, staged.stage(BakeStage::Meshing, 0.8, 0.9), [&](std::size_t, const std::atomic<bool>&) {
-        openvdb::tools::volumeToMesh(*sampled.grid, points, triangles, quads, 0.0, params.bake.adaptivity);
-        removeDegenerateFaces(points, triangles, quads);
-    });
-    sampled.grid.reset();
-
+    // volumeToMesh's arrays become the mesh's, each freed as soon as it is copied, after the
+    // grid: the peak is volumeToMesh's, never the mesh twice.
     Mesh mesh;
-    mesh.positions.reserve(points.size());
-    for (const openvdb::Vec3s& p : points) mesh.positions.emplace_back(p.x(), p.y(), p.z());
-    // volumeToMesh winds faces counter-clockwise seen from the positive (outside) side.
-    for (const auto& triangle : triangles) mesh.triangles.push_back({triangle[0], triangle[1], triangle[2]});
-    for (const auto& quad : quads) mesh.quads.push_back({quad[0], quad[1], quad[2], quad[3]});
-    points = {};
-    triangles = {};
-    quads = {};
-
-    // Vertex normals: the sum of the cross products of the faces around each vertex (normals
-    // weighted by area), normalised.
-    std::vector<glm::dvec3> normalSums(mesh.positions.size(), glm::dvec3(0.0));
-    const std::vector<std::uint32_t> corners = mesh.triangulated();
-    for (std::size_t index = 0; index < corners.size(); index += 3) {
-        const glm::dvec3 a(mesh.positions[corners[index]]), b(mesh.positions[corners[index + 1]]), c(mesh.positions[corners[index + 2]]);
-        const glm::dvec3 normal = glm::cross(b - a, c - a);
-        for (int corner = 0; corner < 3; ++corner) normalSums[corners[index + corner]] += normal;
-    }
-    mesh.normals.resize(mesh.positions.size());
-    for (std::size_t index = 0; index < normalSums.size(); ++index) {
-        const double length = glm::length(normalSums[index]);
-        mesh.normals[index] = length > 0.0 ? glm::vec3(normalSums[index] / length) : glm::vec3(0.0f);
-    }
+    parallelForWithProgress(1, staged.stage(BakeStage::Meshing, 0.8, 0.9), [&](std::size_t, const std::atomic<bool>&) {
+        std::vector<openvdb::Vec3s> points;
+        std::vector<openvdb::Vec3I> triangles;
+        std::vector<openvdb::Vec4I> quads;
+        openvdb::tools::volumeToMesh(*sampled.grid, points, triangles, quads, 0.0, params.bake.adaptivity);
+        sampled.grid.reset();
+        releaseFreedMemory();
+        mesh.positions.reserve(points.size());
+        for (const openvdb::Vec3s& p : points) mesh.positions.emplace_back(p.x(), p.y(), p.z());
+        points = {};
+        // volumeToMesh winds faces counter-clockwise seen from the positive (outside) side.
+        mesh.triangles.reserve(triangles.size());
+        for (const auto& triangle : triangles) mesh.triangles.push_back({triangle[0], triangle[1], triangle[2]});
+        triangles = {};
+        mesh.quads.reserve(quads.size());
+        for (const auto& quad : quads) mesh.quads.push_back({quad[0], quad[1], quad[2], quad[3]});
+    });
+    removeDegenerateFaces(mesh);
+    mesh.normals = vertexNormals(mesh);
 
     // Colours: the material's colouring of the orbit at each vertex, as the renderer shades it.
     if (params.bake.meshColors) {

@@ -92,6 +92,11 @@ struct MemoryModel {
 /// The voxel size of the bake: the bounds' largest side / bake.resolution.
 double bakeVoxelSize(const Params& params);
 
+/// Gives the pages of freed blocks back to the system (malloc_trim). glibc keeps them
+/// otherwise, scattered between live blocks in its per-thread arenas, and the next stage of a
+/// bake would add its memory to theirs.
+void releaseFreedMemory();
+
 /// Samples f for `params` (validated). Throws MemoryLimitError (before sampling) and Cancelled.
 /// Uses progress stages Classifying in [0, split] and Sampling in [split, end].
 SampledSurface sampleSurface(const Params& params, const BakeOptions& options, const MemoryModel& memory,

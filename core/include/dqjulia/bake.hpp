@@ -50,6 +50,7 @@ struct BakeStats {
     std::uint64_t dense = 0;           ///< voxels in the bounds' box: what a dense bake evaluates
     std::uint64_t sampledLeaves = 0;   ///< 8^3 blocks sampled voxel by voxel
     std::uint64_t interiorLeaves = 0;  ///< 8^3 blocks inside the set, never sampled (filled)
+    std::uint64_t prunedLeaves = 0;    ///< sampled blocks then dropped: no surface cell touches them
     std::uint64_t activeVoxels = 0;    ///< active voxels of the surface level set (bakes; 0 for meshes)
     std::uint64_t estimatedBytes = 0;  ///< the memory estimate checked against the limit
     double voxelSize = 0.0;            ///< h, in slice units
