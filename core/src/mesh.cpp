@@ -203,25 +203,41 @@ Mesh bakeMesh(const Params& params, const BakeOptions& options, const ProgressCa
     SampledSurface sampled = sampleSurface(params, options, meshMemoryModel(), staged, 0.05, 0.8);
     BakeStats stats = sampled.stats;
 
-    // volumeToMesh's arrays become the mesh's, each freed as soon as it is copied, after the
-    // grid: the peak is volumeToMesh's, never the mesh twice.
+    // OpenVDB's mesher is used directly, not through volumeToMesh(): its point list and polygon
+    // pools become the mesh's arrays, each freed once copied (after the grid), so the mesh is
+    // never held twice.
     Mesh mesh;
     parallelForWithProgress(1, staged.stage(BakeStage::Meshing, 0.8, 0.9), [&](std::size_t, const std::atomic<bool>&) {
-        std::vector<openvdb::Vec3s> points;
-        std::vector<openvdb::Vec3I> triangles;
-        std::vector<openvdb::Vec4I> quads;
-        openvdb::tools::volumeToMesh(*sampled.grid, points, triangles, quads, 0.0, params.bake.adaptivity);
+        openvdb::tools::VolumeToMesh mesher(0.0, params.bake.adaptivity);
+        mesher(*sampled.grid);
         sampled.grid.reset();
         releaseFreedMemory();
-        mesh.positions.reserve(points.size());
-        for (const openvdb::Vec3s& p : points) mesh.positions.emplace_back(p.x(), p.y(), p.z());
-        points = {};
-        // volumeToMesh winds faces counter-clockwise seen from the positive (outside) side.
-        mesh.triangles.reserve(triangles.size());
-        for (const auto& triangle : triangles) mesh.triangles.push_back({triangle[0], triangle[1], triangle[2]});
-        triangles = {};
-        mesh.quads.reserve(quads.size());
-        for (const auto& quad : quads) mesh.quads.push_back({quad[0], quad[1], quad[2], quad[3]});
+        const openvdb::Vec3s* points = mesher.pointList().get();
+        mesh.positions.resize(mesher.pointListSize());
+        for (std::size_t index = 0; index < mesh.positions.size(); ++index)
+            mesh.positions[index] = glm::vec3(points[index].x(), points[index].y(), points[index].z());
+        mesher.pointList().reset();
+        // Faces are counter-clockwise seen from the positive (outside) side.
+        std::size_t quadCount = 0, triangleCount = 0;
+        for (std::size_t pool = 0; pool < mesher.polygonPoolListSize(); ++pool) {
+            quadCount += mesher.polygonPoolList()[pool].numQuads();
+            triangleCount += mesher.polygonPoolList()[pool].numTriangles();
+        }
+        mesh.quads.reserve(quadCount);
+        mesh.triangles.reserve(triangleCount);
+        for (std::size_t pool = 0; pool < mesher.polygonPoolListSize(); ++pool) {
+            openvdb::tools::PolygonPool& polygons = mesher.polygonPoolList()[pool];
+            for (std::size_t index = 0; index < polygons.numQuads(); ++index) {
+                const openvdb::Vec4I& quad = polygons.quad(index);
+                mesh.quads.push_back({quad[0], quad[1], quad[2], quad[3]});
+            }
+            for (std::size_t index = 0; index < polygons.numTriangles(); ++index) {
+                const openvdb::Vec3I& triangle = polygons.triangle(index);
+                mesh.triangles.push_back({triangle[0], triangle[1], triangle[2]});
+            }
+            polygons.clearQuads();
+            polygons.clearTriangles();
+        }
     });
     removeDegenerateFaces(mesh);
     mesh.normals = vertexNormals(mesh);
