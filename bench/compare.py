@@ -83,10 +83,13 @@ def timed(command, cwd=None):
     return {"wall": seconds, "cpu": user + system, "peak_kb": peak, "stdout": result.stdout}
 
 
-def median_runs(commands, repeat, cwd=None):
-    """Runs each command `repeat` times, interleaved; returns per command the median wall and CPU
-    seconds and the largest peak memory."""
+def median_runs(commands, repeat, cwd=None, warm_up=False):
+    """Runs each command `repeat` times, interleaved (after one untimed run each with `warm_up`,
+    for short commands whose first run would time the loading of their libraries from disk);
+    returns per command the median wall and CPU seconds and the largest peak memory."""
     runs = {name: [] for name in commands}
+    for command in commands.values() if warm_up else []:
+        timed(command, cwd)
     for _ in range(repeat):
         for name, command in commands.items():
             runs[name].append(timed(command, cwd))
@@ -327,7 +330,7 @@ def main():
             "dqjulia": [dqjulia, "render", "-q", "-f", "-p", params, "-o", ours_png],
             "povray": ["povray", f"+I{scene}", f"+O{pov_png}", f"+W{WIDTH}", f"+H{HEIGHT}", "-D", "-V", "+FN", "-GA"],
         }
-        times = median_runs(commands, args.repeat, cwd=work)
+        times = median_runs(commands, args.repeat, cwd=work, warm_up=True)
         _, _, ours_rows = read_png(ours_png)
         _, _, pov_rows = read_png(pov_png)
         ours_mask, pov_mask = silhouette(ours_rows), silhouette(pov_rows)
@@ -361,12 +364,13 @@ def main():
                 }
 
             # Each program's floor: the peak of a 16^3 mesh (its libraries, mapped and relocated).
-            floors = median_runs(mesh_commands(16)[2], 1, cwd=work)
+            floors = median_runs(mesh_commands(16)[2], 1, cwd=work, warm_up=True)
             rows.append(("mesh 16^3 peak MB (floor)", f"{floors['dqjulia']['peak_kb'] / 1024:.0f}",
                          f"Mandelbulber {floors['mandelbulber2']['peak_kb'] / 1024:.0f}", "", "", None))
             for resolution in [int(r) for r in args.mesh_resolutions.split(",")]:
                 ours_ply, mb_ply, commands = mesh_commands(resolution)
-                times = median_runs(commands, 1 if resolution > 256 else args.repeat, cwd=work)
+                short = resolution <= 256
+                times = median_runs(commands, args.repeat if short else 1, cwd=work, warm_up=short)
                 ratio = times["mandelbulber2"]["wall"] / times["dqjulia"]["wall"]
                 memory = times["mandelbulber2"]["peak_kb"] / times["dqjulia"]["peak_kb"]
                 target = resolution == 512
