@@ -16,19 +16,13 @@
 #include <string>
 #include <thread>
 #include <vector>
-#include "test_folder.hpp"
+#include "test_support.hpp"
 
-extern char** environ;
 namespace fs = std::filesystem;
 
-namespace {
+using dqj::test::readFile;
 
-std::string readFile(const fs::path& path) {
-    std::ifstream file(path, std::ios::binary);
-    std::ostringstream text;
-    text << file.rdbuf();
-    return text.str();
-}
+namespace {
 
 struct Outcome {
     int exitCode = -1;
@@ -151,22 +145,6 @@ TEST_F(BakeCli, BadInputGetsOneClearMessageAndWritesNothing) {
     EXPECT_TRUE(files().empty());
 }
 
-/// Starts the CLI with `arguments` (stderr to `errPath`); returns its pid.
-pid_t spawnCli(const std::vector<std::string>& arguments, const fs::path& errPath) {
-    std::vector<std::string> all{DQJ_CLI};
-    all.insert(all.end(), arguments.begin(), arguments.end());
-    std::vector<char*> argv;
-    for (std::string& argument : all) argv.push_back(argument.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 2, errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    pid_t pid = -1;
-    const int status = posix_spawn(&pid, DQJ_CLI, &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    return status == 0 ? pid : -1;
-}
-
 class BakeInterrupt : public BakeCli, public ::testing::WithParamInterface<int> {};
 
 TEST_P(BakeInterrupt, StopsPromptlyAndKeepsThePreviousFile) {
@@ -174,7 +152,7 @@ TEST_P(BakeInterrupt, StopsPromptlyAndKeepsThePreviousFile) {
     std::ofstream(target) << "previous";
     const fs::path errPath = dir_.parent_path() / (dir_.filename().string() + ".stderr");
     // A bake of several seconds; the signal arrives while it samples.
-    const pid_t pid = spawnCli({"bake", "-r", "384", "-f", "-o", target}, errPath);
+    const pid_t pid = dqj::test::spawnProgram(DQJ_CLI, {"bake", "-r", "384", "-f", "-o", target}, errPath);
     ASSERT_GT(pid, 0);
     std::this_thread::sleep_for(std::chrono::milliseconds(1200));
     const auto signalled = std::chrono::steady_clock::now();

@@ -11,9 +11,11 @@
 #include <string>
 
 #include "dqjulia/image.hpp"
-#include "test_folder.hpp"
+#include "test_support.hpp"
 
 namespace fs = std::filesystem;
+
+using dqj::test::readFile;
 
 namespace {
 
@@ -22,13 +24,6 @@ struct Outcome {
     std::string out;
     std::string err;
 };
-
-std::string readFile(const fs::path& path) {
-    std::ifstream file(path, std::ios::binary);
-    std::ostringstream text;
-    text << file.rdbuf();
-    return text.str();
-}
 
 class Cli : public ::testing::Test {
 protected:

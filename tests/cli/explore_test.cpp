@@ -11,17 +11,13 @@
 #include "dqjulia/contact_sheet.hpp"
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/params.hpp"
+#include "test_support.hpp"
 
 namespace fs = std::filesystem;
 
-namespace {
+using dqj::test::readFile;
 
-std::string readFile(const fs::path& path) {
-    std::ifstream file(path, std::ios::binary);
-    std::ostringstream text;
-    text << file.rdbuf();
-    return text.str();
-}
+namespace {
 
 int runCli(const std::string& arguments) {
     const int status = std::system((std::string("'") + DQJ_CLI + "' " + arguments + " 2>/dev/null").c_str());

@@ -22,7 +22,7 @@
 #include "dqjulia/dqjulia.h"
 #include "dqjulia/mesh.hpp"
 #include "dqjulia/params.hpp"
-#include "test_folder.hpp"
+#include "test_support.hpp"
 
 namespace fs = std::filesystem;
 using namespace dqj;

@@ -19,7 +19,7 @@
 
 #include "dqjulia/image.hpp"
 #include "dqjulia/render.hpp"
-#include "test_folder.hpp"
+#include "test_support.hpp"
 
 namespace fs = std::filesystem;
 using namespace dqj;

@@ -23,9 +23,11 @@
 #include "dqjulia/image.hpp"
 #include "dqjulia/povray.hpp"
 #include "dqjulia/render.hpp"
-#include "test_folder.hpp"
+#include "test_support.hpp"
 
 namespace fs = std::filesystem;
+
+using dqj::test::readFile;
 
 namespace {
 
@@ -34,13 +36,6 @@ struct Outcome {
     std::string log;  // POV-Ray's stderr (banner, #debug output, warnings, errors)
     double seconds = 0.0;
 };
-
-std::string readFile(const fs::path& path) {
-    std::ifstream file(path, std::ios::binary);
-    std::ostringstream text;
-    text << file.rdbuf();
-    return text.str();
-}
 
 /// 17 significant digits: POV-Ray and the core read the same double back.
 std::string number(double value) {

@@ -18,19 +18,13 @@
 #include <vector>
 
 #include "dqjulia/dqjulia.h"
-#include "test_folder.hpp"
+#include "test_support.hpp"
 
-extern char** environ;
 namespace fs = std::filesystem;
 
-namespace {
+using dqj::test::readFile;
 
-std::string readFile(const fs::path& path) {
-    std::ifstream file(path, std::ios::binary);
-    std::ostringstream text;
-    text << file.rdbuf();
-    return text.str();
-}
+namespace {
 
 /// A scratch folder per test.
 class Scratch : public ::testing::Test {
@@ -50,22 +44,6 @@ protected:
     bool mounted_ = false;
 };
 
-/// Starts the CLI with `arguments`, stdout/stderr to files in `folder`; returns its pid.
-pid_t spawnCli(const std::vector<std::string>& arguments, const fs::path& errPath) {
-    std::vector<std::string> all{DQJ_CLI};
-    all.insert(all.end(), arguments.begin(), arguments.end());
-    std::vector<char*> argv;
-    for (std::string& argument : all) argv.push_back(argument.data());
-    argv.push_back(nullptr);
-    posix_spawn_file_actions_t actions;
-    posix_spawn_file_actions_init(&actions);
-    posix_spawn_file_actions_addopen(&actions, 2, errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    pid_t pid = -1;
-    const int status = posix_spawn(&pid, DQJ_CLI, &actions, nullptr, argv.data(), environ);
-    posix_spawn_file_actions_destroy(&actions);
-    return status == 0 ? pid : -1;
-}
-
 int waitExit(pid_t pid) {
     int status = 0;
     ::waitpid(pid, &status, 0);
@@ -78,7 +56,7 @@ TEST_P(Interrupt, StopsARenderPromptlyAndKeepsThePreviousOutput) {
     const fs::path output = dir_ / "picture.png";
     std::ofstream(output) << "previous picture";
     // Long enough to be interrupted: several seconds of work on 2 cores.
-    const pid_t pid = spawnCli({"render", "--force", "-W", "1600", "-H", "1200", "-s", "4", "-o", output.string()},
+    const pid_t pid = dqj::test::spawnProgram(DQJ_CLI, {"render", "--force", "-W", "1600", "-H", "1200", "-s", "4", "-o", output.string()},
                                dir_ / "stderr.txt");
     ASSERT_GT(pid, 0);
     std::this_thread::sleep_for(std::chrono::milliseconds(1000));  // well past start-up, even under sanitizers
@@ -104,7 +82,7 @@ TEST_F(Scratch, FullDiskIsReportedAndLeavesNothing) {
         GTEST_SKIP() << "cannot mount a small tmpfs here (" << std::strerror(errno) << "); needs root";
     mounted_ = true;
     const fs::path output = disk / "big.png";
-    const pid_t pid = spawnCli({"render", "-q", "-W", "640", "-H", "480", "-o", output.string()}, dir_ / "stderr.txt");
+    const pid_t pid = dqj::test::spawnProgram(DQJ_CLI, {"render", "-q", "-W", "640", "-H", "480", "-o", output.string()}, dir_ / "stderr.txt");
     ASSERT_GT(pid, 0);
     EXPECT_EQ(waitExit(pid), 1);
     const std::string err = readFile(dir_ / "stderr.txt");

@@ -1,0 +1,58 @@
+// test_support.hpp - helpers the GoogleTest suites share: a scratch folder per test, reading a
+// file whole, and starting a program in the background (for the interrupt tests).
+#pragma once
+#include <fcntl.h>
+#include <gtest/gtest.h>
+#include <spawn.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+extern char** environ;
+
+namespace dqj::test {
+
+/// "<temp>/<prefix>_<pid>_<test name>", emptied and created. The pid keeps parallel ctest
+/// processes apart; a parameterised test's "Name/Param" becomes "Name_Param", one folder, so
+/// removing it leaves nothing behind.
+inline std::filesystem::path freshTestFolder(const std::string& prefix) {
+    std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    std::replace(name.begin(), name.end(), '/', '_');
+    const std::filesystem::path folder =
+        std::filesystem::temp_directory_path() / (prefix + "_" + std::to_string(::getpid()) + "_" + name);
+    std::filesystem::remove_all(folder);
+    std::filesystem::create_directories(folder);
+    return folder;
+}
+
+/// The whole file as bytes; "" if it cannot be read.
+inline std::string readFile(const std::filesystem::path& path) {
+    std::ifstream file(path, std::ios::binary);
+    std::ostringstream text;
+    text << file.rdbuf();
+    return text.str();
+}
+
+/// Starts `program` with `arguments`, its stderr into `errPath`; returns its pid, or -1.
+inline pid_t spawnProgram(const std::string& program, const std::vector<std::string>& arguments,
+                          const std::filesystem::path& errPath) {
+    std::vector<std::string> all{program};
+    all.insert(all.end(), arguments.begin(), arguments.end());
+    std::vector<char*> argv;
+    for (std::string& argument : all) argv.push_back(argument.data());
+    argv.push_back(nullptr);
+    posix_spawn_file_actions_t actions;
+    posix_spawn_file_actions_init(&actions);
+    posix_spawn_file_actions_addopen(&actions, 2, errPath.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    pid_t pid = -1;
+    const int status = posix_spawn(&pid, program.c_str(), &actions, nullptr, argv.data(), environ);
+    posix_spawn_file_actions_destroy(&actions);
+    return status == 0 ? pid : -1;
+}
+
+}  // namespace dqj::test
