@@ -315,6 +315,15 @@ def main():
         sys.exit(f"{dqjulia} not found: build first (bench/run.sh does)")
     work = args.keep or tempfile.mkdtemp(prefix="dqjulia_compare_")
     os.makedirs(work, exist_ok=True)
+    try:
+        compare(args, dqjulia, work)
+    finally:
+        if not args.keep:  # the images and meshes (tens of MB) go unless asked for
+            shutil.rmtree(work, ignore_errors=True)
+
+
+def compare(args, dqjulia, work):
+    """Runs the measurements in the folder `work` and prints the table."""
     params = os.path.join(work, "quaternion_julia.json")
     dqjulia_params(params)
     rows = []  # (measure, dqjulia, other, ratio text, target, met)
@@ -440,7 +449,8 @@ def main():
     for row in rows:
         met = "" if row[5] is None else ("yes" if row[5] else "NO")
         print("  ".join(str(c).ljust(w) for c, w in zip(row[:5], width)) + "  " + met)
-    print(f"\n(same run; medians of {args.repeat} interleaved runs where repeated; outputs in {work})")
+    kept = f"; outputs in {work}" if args.keep else ""
+    print(f"\n(same run; medians of {args.repeat} interleaved runs where repeated{kept})")
 
 
 if __name__ == "__main__":
