@@ -92,6 +92,14 @@ def _read_params(operator, context, path, done_message):
     return {"FINISHED"}
 
 
+class _NeedsDQJuliaObject:
+    """For operators that act on the active DQ Julia object: unavailable without one."""
+
+    @classmethod
+    def poll(cls, context):
+        return dqjulia_object(context) is not None
+
+
 class DQJULIA_OT_add(bpy.types.Operator):
     """Add a DQ Julia object: the set ray-marched in the viewport inside its bounds"""
     bl_idname = "object.dqjulia_add"
@@ -131,7 +139,7 @@ class DQJULIA_OT_add(bpy.types.Operator):
         return {"FINISHED"}
 
 
-class DQJULIA_OT_load_preset(bpy.types.Operator):
+class DQJULIA_OT_load_preset(_NeedsDQJuliaObject, bpy.types.Operator):
     """Load one of the example parameter files into the active DQ Julia object"""
     bl_idname = "dqjulia.load_preset"
     bl_label = "Load Preset"
@@ -139,16 +147,12 @@ class DQJULIA_OT_load_preset(bpy.types.Operator):
 
     preset: EnumProperty(name="Preset", items=_preset_items)
 
-    @classmethod
-    def poll(cls, context):
-        return dqjulia_object(context) is not None
-
     def execute(self, context):
         return _read_params(self, context, os.path.join(PRESET_DIR, self.preset + ".json"),
                             "Loaded preset %s" % self.preset)
 
 
-class DQJULIA_OT_import_params(bpy.types.Operator, ImportHelper):
+class DQJULIA_OT_import_params(_NeedsDQJuliaObject, bpy.types.Operator, ImportHelper):
     """Read a dqjulia parameter file (the JSON the command-line tool reads) into the active DQ Julia object"""
     bl_idname = "dqjulia.import_params"
     bl_label = "Import Parameters"
@@ -157,25 +161,17 @@ class DQJULIA_OT_import_params(bpy.types.Operator, ImportHelper):
     filename_ext = ".json"
     filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
 
-    @classmethod
-    def poll(cls, context):
-        return dqjulia_object(context) is not None
-
     def execute(self, context):
         return _read_params(self, context, self.filepath, "Read %s" % self.filepath)
 
 
-class DQJULIA_OT_export_params(bpy.types.Operator, ExportHelper):
+class DQJULIA_OT_export_params(_NeedsDQJuliaObject, bpy.types.Operator, ExportHelper):
     """Write the active DQ Julia object's parameters (and keyframes) as a dqjulia parameter file"""
     bl_idname = "dqjulia.export_params"
     bl_label = "Export Parameters"
 
     filename_ext = ".json"
     filter_glob: StringProperty(default="*.json", options={"HIDDEN"})
-
-    @classmethod
-    def poll(cls, context):
-        return dqjulia_object(context) is not None
 
     def execute(self, context):
         if not _library_ready(self):
@@ -194,7 +190,7 @@ class DQJULIA_OT_export_params(bpy.types.Operator, ExportHelper):
         return {"FINISHED"}
 
 
-class DQJULIA_OT_collection_edit(bpy.types.Operator):
+class DQJULIA_OT_collection_edit(_NeedsDQJuliaObject, bpy.types.Operator):
     """Add or remove an entry of a list (rotations, lights, palette)"""
     bl_idname = "dqjulia.collection_edit"
     bl_label = "Edit List"
@@ -204,10 +200,6 @@ class DQJULIA_OT_collection_edit(bpy.types.Operator):
                                     ("palette", "Palette", "")])
     action: EnumProperty(items=[("ADD", "Add", ""), ("REMOVE", "Remove", "")])
     index: bpy.props.IntProperty(default=-1)
-
-    @classmethod
-    def poll(cls, context):
-        return dqjulia_object(context) is not None
 
     def execute(self, context):
         settings = dqjulia_object(context).dqjulia
@@ -452,15 +444,11 @@ class DQJULIA_OT_cancel_bakes(bpy.types.Operator):
         return {"FINISHED"}
 
 
-class DQJULIA_OT_add_osl_volume(bpy.types.Operator):
+class DQJULIA_OT_add_osl_volume(_NeedsDQJuliaObject, bpy.types.Operator):
     """Add a cube over the bounds with a Cycles OSL volume material that computes the set while rendering (needs a Blender built with OSL)"""
     bl_idname = "dqjulia.add_osl_volume"
     bl_label = "Add OSL Volume"
     bl_options = {"REGISTER", "UNDO"}
-
-    @classmethod
-    def poll(cls, context):
-        return dqjulia_object(context) is not None
 
     def execute(self, context):
         if not osl.available():
