@@ -24,29 +24,14 @@ using dqj::test::readFile;
 
 namespace {
 
-struct Outcome {
-    int exitCode = -1;
-    std::string out;
-    std::string err;
-};
+using Outcome = dqj::test::CommandResult;
 
 class BakeCli : public ::testing::Test {
 protected:
     void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_bake_cli"); }
     void TearDown() override { fs::remove_all(dir_); }
 
-    Outcome run(const std::string& arguments) {
-        const fs::path out = dir_ / ".stdout", err = dir_ / ".stderr";
-        const std::string command = std::string("'") + DQJ_CLI + "' " + arguments + " > '" + out.string() + "' 2> '" + err.string() + "'";
-        const int status = std::system(command.c_str());
-        Outcome result;
-        result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-        result.out = readFile(out);
-        result.err = readFile(err);
-        fs::remove(out);
-        fs::remove(err);
-        return result;
-    }
+    Outcome run(const std::string& arguments) { return dqj::test::runCommand(DQJ_CLI, arguments, dir_); }
     std::string path(const std::string& name) const { return (dir_ / name).string(); }
     std::string write(const std::string& name, const std::string& text) {
         std::ofstream(dir_ / name) << text;

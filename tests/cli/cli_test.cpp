@@ -19,11 +19,7 @@ using dqj::test::readFile;
 
 namespace {
 
-struct Outcome {
-    int exitCode = -1;
-    std::string out;
-    std::string err;
-};
+using Outcome = dqj::test::CommandResult;
 
 class Cli : public ::testing::Test {
 protected:
@@ -32,16 +28,7 @@ protected:
 
     /// Runs `dqjulia <arguments>` with `input` on stdin.
     Outcome run(const std::string& arguments, const std::string& input = "") {
-        const fs::path in = dir_ / "stdin.txt", out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
-        std::ofstream(in) << input;
-        const std::string command = std::string("'") + DQJ_CLI + "' " + arguments + " < '" + in.string() + "' > '" +
-                                    out.string() + "' 2> '" + err.string() + "'";
-        const int status = std::system(command.c_str());
-        Outcome result;
-        result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-        result.out = readFile(out);
-        result.err = readFile(err);
-        return result;
+        return dqj::test::runCommand(DQJ_CLI, arguments, dir_, input);
     }
     std::string path(const std::string& name) const { return (dir_ / name).string(); }
     std::string write(const std::string& name, const std::string& text) {

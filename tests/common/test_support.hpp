@@ -1,12 +1,15 @@
 // test_support.hpp - helpers the GoogleTest suites share: a scratch folder per test, reading a
-// file whole, and starting a program in the background (for the interrupt tests).
+// file whole, running a command and capturing its output, and starting a program in the
+// background (for the interrupt tests).
 #pragma once
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <spawn.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -36,6 +39,31 @@ inline std::string readFile(const std::filesystem::path& path) {
     std::ostringstream text;
     text << file.rdbuf();
     return text.str();
+}
+
+/// What a command did: its exit code (-1 if it did not exit normally) and its output.
+struct CommandResult {
+    int exitCode = -1;
+    std::string out;
+    std::string err;
+};
+
+/// Runs `program arguments` through the shell (so arguments are quoted as on a command line),
+/// `input` on stdin. Its stdin, stdout and stderr go through hidden files in `scratch`, removed
+/// afterwards, so tests that list the folder see only what the command wrote.
+inline CommandResult runCommand(const std::string& program, const std::string& arguments,
+                                const std::filesystem::path& scratch, const std::string& input = "") {
+    const std::filesystem::path in = scratch / ".stdin", out = scratch / ".stdout", err = scratch / ".stderr";
+    std::ofstream(in) << input;
+    const std::string command = "'" + program + "' " + arguments + " < '" + in.string() + "' > '" + out.string() +
+                                "' 2> '" + err.string() + "'";
+    const int status = std::system(command.c_str());
+    CommandResult result;
+    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    result.out = readFile(out);
+    result.err = readFile(err);
+    for (const std::filesystem::path& file : {in, out, err}) std::filesystem::remove(file);
+    return result;
 }
 
 /// Starts `program` with `arguments`, its stderr into `errPath`; returns its pid, or -1.
