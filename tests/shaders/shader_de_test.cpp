@@ -104,6 +104,17 @@ struct Agreement {
     double maxRelativeModerate = 0.0; // where |dz| <= 100 (away from the set's surface)
     double maxRatioToBound = 0.0;     // max of relative / (eps_float * max(1, |dz|))
     long overTolerance = 0;
+
+    void add(const Agreement& other) {
+        points += other.points;
+        escapeMismatches += other.escapeMismatches;
+        unexplainedMismatches += other.unexplainedMismatches;
+        compared += other.compared;
+        overTolerance += other.overTolerance;
+        maxRelative = std::max(maxRelative, other.maxRelative);
+        maxRelativeModerate = std::max(maxRelativeModerate, other.maxRelativeModerate);
+        maxRatioToBound = std::max(maxRatioToBound, other.maxRatioToBound);
+    }
 };
 
 template <typename Evaluate>
@@ -211,14 +222,7 @@ TEST(ShaderDistanceEstimate, GlslMatchesCore) {
                         de = e.de;
                     }, one);
                 }
-                total.points += one.points;
-                total.escapeMismatches += one.escapeMismatches;
-                total.unexplainedMismatches += one.unexplainedMismatches;
-                total.compared += one.compared;
-                total.overTolerance += one.overTolerance;
-                total.maxRelative = std::max(total.maxRelative, one.maxRelative);
-                total.maxRelativeModerate = std::max(total.maxRelativeModerate, one.maxRelativeModerate);
-                total.maxRatioToBound = std::max(total.maxRatioToBound, one.maxRatioToBound);
+                total.add(one);
                 if (one.unexplainedMismatches || one.overTolerance)
                     ADD_FAILURE() << config.name << " variant " << dqj::variantName(variant) << " N=" << iterations;
             }
