@@ -128,7 +128,8 @@ def _replace(context, source, kind, name, data, files):
     return obj
 
 
-def volume_material(name, grid_names):
+def principled_volume_material(name):
+    """A new node material of one Principled Volume wired to the output: (material, volume node)."""
     material = bpy.data.materials.new(name)
     material.use_nodes = True
     tree = material.node_tree
@@ -137,6 +138,13 @@ def volume_material(name, grid_names):
     output.location = (300, 0)
     volume = tree.nodes.new("ShaderNodeVolumePrincipled")
     volume.location = (0, 0)
+    tree.links.new(volume.outputs["Volume"], output.inputs["Volume"])
+    return material, volume
+
+
+def volume_material(name, grid_names):
+    material, volume = principled_volume_material(name)
+    tree = material.node_tree
     volume.inputs["Density"].default_value = VOLUME_DENSITY_SCALE
     if "Density Attribute" in volume.inputs:
         volume.inputs["Density Attribute"].default_value = "density"
@@ -147,7 +155,6 @@ def volume_material(name, grid_names):
         attribute.attribute_name = "color"
         attribute.location = (-250, 100)
         tree.links.new(attribute.outputs["Color"], volume.inputs["Color"])
-    tree.links.new(volume.outputs["Volume"], output.inputs["Volume"])
     return material
 
 

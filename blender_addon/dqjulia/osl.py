@@ -10,7 +10,7 @@ import os
 import bpy
 from bpy.app.handlers import persistent
 
-from . import preview
+from . import bakes, preview
 
 SCRIPT_PATH = os.path.join(os.path.dirname(os.path.abspath(__file__)), "shaders", "dqjulia_density.osl")
 TEXT_NAME = "dqjulia_density.osl"
@@ -84,16 +84,10 @@ def add_volume(context, source):
     faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
     mesh.from_pydata(corners, [], faces)  # 8 corners: the mesh bakes use foreach_set
     mesh.update()
-    material = bpy.data.materials.new("%s OSL" % source.name)
-    material.use_nodes = True
+    material, volume = bakes.principled_volume_material("%s OSL" % source.name)
     tree = material.node_tree
-    tree.nodes.clear()
-    output = tree.nodes.new("ShaderNodeOutputMaterial")
-    output.location = (500, 0)
-    volume = tree.nodes.new("ShaderNodeVolumePrincipled")
-    volume.location = (250, 0)
     script = tree.nodes.new("ShaderNodeScript")
-    script.location = (-100, 0)
+    script.location = (-350, 0)
     script.mode = "INTERNAL"
     script.script = shader_text()
     if "Density" not in script.outputs:
@@ -101,7 +95,6 @@ def add_volume(context, source):
         bpy.data.meshes.remove(mesh)
         raise RuntimeError("Cycles did not compile the OSL script (no outputs); see the console")
     tree.links.new(script.outputs["Density"], volume.inputs["Density"])
-    tree.links.new(volume.outputs["Volume"], output.inputs["Volume"])
     sync_node(script, source)
     mesh.materials.append(material)
     obj = bpy.data.objects.new(mesh.name, mesh)
