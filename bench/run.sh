@@ -9,6 +9,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh libbenchmark-dev mandelbulber2 time
 
+scripts/build-deps.sh >/dev/null  # the static third-party libraries (cached)
 cmake -S . -B build-bench -DCMAKE_BUILD_TYPE=Release -DDQJ_BUILD_BENCH=ON -DDQJ_BUILD_TESTS=OFF >/dev/null
 cmake --build build-bench -j"$(nproc)" --target dqjulia_cli dqjulia_bench
 exec /usr/bin/python3 bench/compare.py --build build-bench "$@"

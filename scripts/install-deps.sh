@@ -6,8 +6,9 @@ set -euo pipefail
 
 packages=(
   build-essential cmake pkg-config clang libclang-rt-14-dev
-  libglm-dev libtbb-dev nlohmann-json3-dev libcli11-dev libpng-dev libopenexr-dev
-  libgtest-dev libopenvdb-dev libboost-iostreams-dev libfreetype-dev fonts-dejavu-core libhwy-dev
+  libglm-dev nlohmann-json3-dev libcli11-dev libgtest-dev libfreetype-dev fonts-dejavu-core
+  libboost-dev  # headers only: OpenVDB's, built statically by scripts/build-deps.sh with its other libraries
+  debootstrap   # tests/cleanroom: the add-on's library loaded in a minimal Debian root
   blender  # the bake tests load the VDB files and meshes in the real Blender (tests/blender)
   xvfb xauth glslang-tools  # the add-on's preview in a real Blender window (xvfb-run); its GLSL checked
   povray  # tests/povray evaluate dqjulia.inc and render generated scenes in the real POV-Ray 3.7

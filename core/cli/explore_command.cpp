@@ -4,8 +4,8 @@
 
 #include "commands.hpp"
 #include "common.hpp"
-#include "dqjulia/contact_sheet.hpp"
-#include "dqjulia/explore.hpp"
+#include "contact_sheet.hpp"
+#include "explore.hpp"
 #include "dqjulia/render.hpp"
 
 namespace dqj::cli {

@@ -8,7 +8,7 @@
 #include "dqjulia/image.hpp"
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/render.hpp"
-#include "dqjulia/voxel_render.hpp"
+#include "voxel_render.hpp"
 
 namespace dqj::cli {
 namespace {

@@ -3,7 +3,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
-#include "dqjulia/contact_sheet.hpp"
+#include "contact_sheet.hpp"
 
 namespace dqj::cli {
 namespace {

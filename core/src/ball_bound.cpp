@@ -50,15 +50,15 @@ BallBound boundBall(const Fractal& fractal, const DualQuat& centre, double radiu
     if (fractal.variant == Variant::PaperCoupled) {
         // One 8-D orbit (a, b): its norm spreads as one vector, since each part obeys the bound.
         Quat a = centre.a, b = centre.b;
-        double spread = padded(std::hypot(radiusA, radiusB));
+        double spread = padded(hypot2(radiusA, radiusB));
         double derivative = 1.0;
         for (int k = 1; k <= fractal.iterations; ++k) {
-            const double r = std::hypot(norm(a), norm(b));
+            const double r = hypot2(norm(a), norm(b));
             derivative *= 2.0 * (r + spread);
             spread = 2.0 * r * spread + spread * spread;
             a = square(a) + fractal.c.a;
             b = square(b) + fractal.c.b;
-            const double next = std::hypot(norm(a), norm(b));
+            const double next = hypot2(norm(a), norm(b));
             if (!std::isfinite(next) || !std::isfinite(spread)) return result;
             if (next + spread > bailout) least = std::min(least, leastEstimate(std::max(bailout, next - spread), derivative));
             if (next - spread > bailout) {

@@ -106,7 +106,7 @@ double minimumBailout(const Fractal& fractal) {
     const double dualRadius = containmentRadius(fractal.c.b);
     // One 8-D norm: sqrt(|a|^2 + |b|^2) > R must imply |a| > r_K(c_a) or |b| > r_K(c_b),
     // else points of the set (both parts just inside their r_K) would count as escaped.
-    if (fractal.variant == Variant::PaperCoupled) return std::hypot(realRadius, dualRadius);
+    if (fractal.variant == Variant::PaperCoupled) return hypot2(realRadius, dualRadius);
     return std::max(realRadius, dualRadius);
 }
 

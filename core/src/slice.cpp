@@ -220,7 +220,7 @@ std::optional<Bounds> containingBounds(const Fractal& fractal, const Slice& slic
         // Paper rules: a escapes beyond r_K(c_a), b beyond r_K(c_b); each constraint alone bounds.
         fits.push_back(fitSphere(slice, real, realRadius));
         fits.push_back(fitSphere(slice, dual, dualRadius));
-        fits.push_back(fitSphere(slice, all, std::hypot(realRadius, dualRadius)));
+        fits.push_back(fitSphere(slice, all, hypot2(realRadius, dualRadius)));
     }
     std::optional<Bounds> best;
     for (const SphereFit& fit : fits) {

@@ -8,7 +8,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "dqjulia/contact_sheet.hpp"
+#include "contact_sheet.hpp"
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/params.hpp"
 #include "test_support.hpp"

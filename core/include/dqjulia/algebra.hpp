@@ -7,6 +7,7 @@
 // part; in files and on the command line it is 8 numbers, a's four then b's four.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <string_view>
@@ -40,6 +41,18 @@ inline double& component(Quat& q, int index) {
 
 inline double dot4(const Quat& p, const Quat& q) { return p.w * q.w + p.x * q.x + p.y * q.y + p.z * q.z; }
 inline double norm(const Quat& q) { return std::sqrt(dot4(q, q)); }
+
+/// sqrt(x^2 + y^2) without overflow or underflow: the length of the 8-D vector (a, b) from
+/// |a| and |b|. The library's own, rather than std::hypot, so every build of it (the static
+/// archive, the self-contained shared library, any glibc) rounds the same way.
+inline double hypot2(double x, double y) {
+    x = std::fabs(x);
+    y = std::fabs(y);
+    const double big = std::max(x, y);
+    if (!(big > 0.0) || std::isinf(big)) return x + y;  // zero, infinity or NaN
+    const double u = x / big, v = y / big;
+    return big * std::sqrt(u * u + v * v);
+}
 
 /// Hamilton square: (s^2 - |v|^2, 2 s v). Cheaper than q*q and equal to it.
 inline Quat square(const Quat& q) {

@@ -1,4 +1,4 @@
-// dqjulia/voxel_render.hpp - draws a baked VDB's voxels as cubes: the paper's "Voxel vs
+// voxel_render.hpp - draws a baked VDB's voxels as cubes: the paper's "Voxel vs
 // Ray-Traced" figure, where a 50^3 or 100^3 grid loses the detail sphere tracing keeps.
 //
 // Reads the fog volume `density` of a file written by bakeVdb(), and casts one ray per
@@ -11,13 +11,12 @@
 
 #include <string>
 
-#include "dqjulia/export.h"
 #include "dqjulia/render.hpp"
 
 namespace dqj {
 
 /// Throws std::runtime_error if the file cannot be read or has no float grid `density`,
 /// Cancelled if `progress` returned false.
-DQJ_API RenderResult renderVoxels(const Params& params, const std::string& vdbPath, const ProgressCallback& progress = {});
+RenderResult renderVoxels(const Params& params, const std::string& vdbPath, const ProgressCallback& progress = {});
 
 }  // namespace dqj

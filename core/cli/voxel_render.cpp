@@ -1,5 +1,5 @@
 // Voxel rendering of a baked density grid (voxel_render.hpp).
-#include "dqjulia/voxel_render.hpp"
+#include "voxel_render.hpp"
 
 #include <algorithm>
 #include <atomic>

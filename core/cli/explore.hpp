@@ -1,4 +1,4 @@
-// dqjulia/explore.hpp - seeded random constants for exploring, empty slices skipped.
+// explore.hpp - seeded random constants for exploring, empty slices skipped.
 //
 // Each part of the constant is drawn as a complex number near the edge of the Mandelbrot set
 // (where Julia sets are detailed rather than blobs or dust) and turned into a quaternion by a random direction of the
@@ -10,7 +10,6 @@
 #include <cstdint>
 #include <vector>
 
-#include "dqjulia/export.h"
 #include "dqjulia/params.hpp"
 
 namespace dqj {
@@ -29,9 +28,9 @@ struct ExploreResult {
 };
 
 /// Draws constants until `count` have non-empty slices (or maxAttempts is reached).
-DQJ_API ExploreResult explore(const Params& base, const ExploreOptions& options);
+ExploreResult explore(const Params& base, const ExploreOptions& options);
 
 /// "(-0.12, 0.65, 0.03, 0)(0.1, -0.2, 0, 0.3)": the constant as the paper prints it.
-DQJ_API std::string constantText(const DualQuat& c, int decimals = 3);
+std::string constantText(const DualQuat& c, int decimals = 3);
 
 }  // namespace dqj

@@ -1,5 +1,5 @@
 // Contact sheets (contact_sheet.hpp): grid layout and FreeType labels.
-#include "dqjulia/contact_sheet.hpp"
+#include "contact_sheet.hpp"
 
 #include <ft2build.h>
 #include FT_FREETYPE_H

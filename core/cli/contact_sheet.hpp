@@ -1,4 +1,4 @@
-// dqjulia/contact_sheet.hpp - lays images out in a labelled grid (contact sheets for
+// contact_sheet.hpp - lays images out in a labelled grid (contact sheets for
 // `dqjulia explore` and the paper's figures).
 //
 // Each tile is drawn at its own size in a grid cell, with its label (one or more lines,
@@ -12,7 +12,6 @@
 
 #include <glm/vec3.hpp>
 
-#include "dqjulia/export.h"
 #include "dqjulia/image.hpp"
 
 namespace dqj {
@@ -32,10 +31,10 @@ struct SheetLayout {
 };
 
 /// The sheet as one image. Throws std::runtime_error if no font can be loaded or `tiles` is empty.
-DQJ_API Image composeSheet(const std::vector<SheetTile>& tiles, const SheetLayout& layout = {});
+Image composeSheet(const std::vector<SheetTile>& tiles, const SheetLayout& layout = {});
 
 /// The font used for labels (the first that exists of a list of system fonts; the environment
 /// variable DQJ_FONT overrides it). Empty if none is found.
-DQJ_API std::string labelFontPath();
+std::string labelFontPath();
 
 }  // namespace dqj

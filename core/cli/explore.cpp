@@ -1,5 +1,5 @@
 // Exploration (explore.hpp): reproducible random constants with non-empty slices.
-#include "dqjulia/explore.hpp"
+#include "explore.hpp"
 
 #include <cmath>
 #include <complex>

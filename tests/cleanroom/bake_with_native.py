@@ -1,0 +1,56 @@
+"""Loads libdqjulia through the add-on's own native.py (outside Blender) and bakes a VDB and a
+mesh of the default fractal. Prints one JSON line with what was made, so the clean-room test
+can compare a run inside a minimal Debian root with the same run on the build machine.
+
+Usage: python3 bake_with_native.py ADDON_DIR WORK_DIR [RESOLUTION]
+ADDON_DIR is the add-on's package folder from the zip (dqjulia/, holding native.py and lib/).
+"""
+
+import importlib.util
+import json
+import os
+import sys
+
+
+def load_native(addon_dir):
+    # native.py alone, as a module of a stand-in package: the add-on's __init__ needs bpy.
+    spec = importlib.util.spec_from_file_location("dqjulia_native", os.path.join(addon_dir, "native.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def main():
+    addon_dir, work = sys.argv[1], sys.argv[2]
+    resolution = int(sys.argv[3]) if len(sys.argv) > 3 else 96
+    native = load_native(addon_dir)
+    os.environ.pop(native.LIBRARY_ENV, None)
+    error = native.load_error()
+    if error is not None:
+        print("cannot load the library: %s" % error, file=sys.stderr)
+        return 1
+    os.makedirs(work, exist_ok=True)
+    vdb = os.path.join(work, "cleanroom.vdb")
+    ply = os.path.join(work, "cleanroom.ply")
+    with native.Context() as context:
+        context.set_bake_resolution(resolution)
+        context.bake_vdb(vdb)
+        bake = context.bake_stats()
+        context.mesh_compute()
+        vertices, triangles = context.mesh_sizes()
+        context.mesh_write(ply)
+    print(json.dumps({
+        "version": native.version()[1],
+        "library": native.library_path(),
+        "vdb_bytes": os.path.getsize(vdb),
+        "active_voxels": bake.active_voxels,
+        "voxels_evaluated": bake.voxels_evaluated,
+        "mesh_vertices": vertices,
+        "mesh_triangles": triangles,
+        "ply_bytes": os.path.getsize(ply),
+    }, sort_keys=True))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
