@@ -2,7 +2,7 @@
 #   dqjulia/            the Python package, shaders/ and blender_manifest.toml
 #   dqjulia/_buildinfo.py
 #   dqjulia/presets/    examples/*.json
-#   dqjulia/lib/libdqjulia.so   the real library file (not a symlink)
+#   dqjulia/lib/libdqjulia.so   the real library file (not a symlink), stripped
 cmake_minimum_required(VERSION 3.25)
 file(REMOVE_RECURSE "${STAGE}")
 file(MAKE_DIRECTORY "${STAGE}/dqjulia/lib" "${STAGE}/dqjulia/presets")
@@ -12,6 +12,12 @@ file(COPY "${BUILDINFO}" DESTINATION "${STAGE}/dqjulia")
 file(GLOB examples "${EXAMPLES}/*.json")
 file(COPY ${examples} DESTINATION "${STAGE}/dqjulia/presets")
 file(COPY_FILE "${LIBRARY}" "${STAGE}/dqjulia/lib/libdqjulia.so")
+if(STRIP)  # the symbol table is for debuggers; the dynamic symbols (dqj_*) stay
+  execute_process(COMMAND "${STRIP}" --strip-unneeded "${STAGE}/dqjulia/lib/libdqjulia.so" RESULT_VARIABLE result)
+  if(NOT result EQUAL 0)
+    message(FATAL_ERROR "could not strip ${STAGE}/dqjulia/lib/libdqjulia.so")
+  endif()
+endif()
 get_filename_component(zip_dir "${ZIP}" DIRECTORY)
 file(MAKE_DIRECTORY "${zip_dir}")
 file(REMOVE "${ZIP}.tmp")

@@ -33,6 +33,15 @@ def main():
     vdb = os.path.join(work, "cleanroom.vdb")
     ply = os.path.join(work, "cleanroom.ply")
     with native.Context() as context:
+        # An error inside the library comes back as a message (a C++ exception unwound and
+        # caught inside it: the static unwinder works on this system).
+        try:
+            context.set_params_json('{"fractal": {"iterations": "many"}}')
+        except native.NativeError as error:
+            rejected = error.message
+        else:
+            print("a bad parameter document was accepted", file=sys.stderr)
+            return 1
         context.set_bake_resolution(resolution)
         context.bake_vdb(vdb)
         bake = context.bake_stats()
@@ -48,6 +57,7 @@ def main():
         "mesh_vertices": vertices,
         "mesh_triangles": triangles,
         "ply_bytes": os.path.getsize(ply),
+        "error_message": rejected,
     }, sort_keys=True))
     return 0
 

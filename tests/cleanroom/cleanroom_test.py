@@ -97,6 +97,8 @@ def main():
     for key in ("vdb_bytes", "active_voxels", "voxels_evaluated", "mesh_vertices", "mesh_triangles", "ply_bytes"):
         checks["%s equal (%s)" % (key, clean[key])] = clean[key] == host[key] and clean[key] > 0
     checks["library version %s" % clean["version"]] = clean["version"] == host["version"]
+    checks["errors explained (%s)" % clean["error_message"]] = (
+        clean["error_message"] == host["error_message"] and "iterations" in clean["error_message"])
     failed = [name for name, ok in checks.items() if not ok]
     for name, ok in checks.items():
         print("%s: %s" % ("ok" if ok else "FAIL", name))
