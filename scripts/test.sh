@@ -9,8 +9,9 @@ scripts/build.sh
 ctest --test-dir build --output-on-failure -j"$(nproc)"
 
 echo "dqjulia: sanitizer and fuzzing run (clang, ASan + UBSan)"
-CC=clang CXX=clang++ cmake -S . -B build-sanitize -DDQJ_DEPS_PREFIX="$(scripts/build-deps.sh --print)" -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DDQJ_SANITIZE=ON -DDQJ_FUZZ=ON >/dev/null
+source scripts/ccache.sh
+CC=clang CXX=clang++ cmake -S . -B build-sanitize -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDQJ_SANITIZE=ON -DDQJ_FUZZ=ON \
+  -DDQJ_DEPS_PREFIX="$(scripts/build-deps.sh --print)" "${DQJ_LAUNCHER[@]}" >/dev/null
 cmake --build build-sanitize -j"$(nproc)"
 # Blender loads the library into its own (uninstrumented) process, where an ASan library cannot run.
 ctest --test-dir build-sanitize --output-on-failure -j"$(nproc)" -LE blender
