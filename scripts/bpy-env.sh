@@ -69,14 +69,16 @@ for v in "${wanted[@]}"; do
   echo "bpy-env.sh: making the venv for bpy==$v in $final" >&2
   tmp="$(mktemp -d "$cache/.$v.XXXXXX")"
   # bin/python and `python -m pip` do not depend on the venv's folder name, so it is built at a
-  # temporary name and moved (only the console scripts' #! lines name the temporary folder:
-  # run pytest as `python -m pytest`).
+  # temporary name and moved (only the console scripts' #! lines, bin/pip for one, name the
+  # temporary folder: use `python -m pip`).
   trap 'rm -rf "$tmp"' EXIT
   "$python" -m venv "$tmp/venv"
   "$tmp/venv/bin/python" -m pip install --quiet --no-input "bpy==$v"
   "$tmp/venv/bin/python" -c 'import bpy, sys; print("bpy", bpy.app.version_string, file=sys.stderr)'
-  rm -rf "$final"
-  mv "$tmp/venv" "$final"
+  if [ ! -x "$final/bin/python" ]; then  # (another run may have finished it meanwhile)
+    rm -rf "$final"
+    mv "$tmp/venv" "$final"
+  fi
   rm -rf "$tmp"
   trap - EXIT
 done
