@@ -1,7 +1,9 @@
-"""Helpers shared by the Blender tests (run inside Blender: blender ... --python test.py -- args).
+"""Helpers shared by the Blender tests, run inside Blender (blender ... --python test.py -- args)
+or in a bpy wheel's Python (VENV/bin/python test.py -- args; scripts/bpy-env.sh).
 
-The tests install the add-on from the zip the build made, exactly as a user would, into the
-user folders the test runner points BLENDER_USER_* at (never the real user's).
+The tests install the add-on from the zip the build made, exactly as a user would (an extension
+in 4.2+, a legacy add-on before), into the user folders the test runner points BLENDER_USER_*
+at (never the real user's).
 """
 
 import argparse
