@@ -9,7 +9,8 @@
 #   scripts/bpy-env.sh --list            print the exact versions, one a line
 #
 # A venv is built in a temporary folder beside its final place and renamed into place only when
-# `import bpy` works, so a half-made one is never used; an existing one costs nothing.
+# `import bpy` works, so a half-made one is never used; an existing one costs nothing. Its
+# requirements (the wheel and numpy, pinned) are kept in it: when they change, it is remade.
 # The wheels need CPython 3.11 (DQJ_BPY_PYTHON, default python3). Each is 200-320 MB; the
 # wheels' own dependencies (numpy, requests, zstandard, cython: declared by every bpy wheel)
 # come with them from PyPI; the add-on and its tests need none of them (tests/blender).
@@ -32,6 +33,17 @@ exact() {  # a series (4.5) or an exact version (4.5.15) -> the pinned exact ver
   return 1
 }
 
+requirements() {  # what a venv holds, one a line; kept in the venv as $stamp
+  # numpy: the wheels 4.5 and 5.0 require >=1.26,<2 (and get 1.26.4); 4.2.23 names numpy
+  # unpinned, which would bring numpy 2 beside a Blender built against 1.26: 1.26.4 for all.
+  printf 'bpy==%s\nnumpy==1.26.4\n' "$1"
+}
+stamp=dqjulia-requirements.txt
+
+ready() {  # the venv exists, complete, with these requirements
+  [ -x "$1/bin/python" ] && [ "$(cat "$1/$stamp" 2>/dev/null)" = "$(requirements "$2")" ]
+}
+
 if [ "${1:-}" = "--list" ]; then
   printf '%s\n' "${versions[@]}"
   exit 0
@@ -40,7 +52,7 @@ if [ "${1:-}" = "--print" ]; then
   [ $# -eq 2 ] || { echo "usage: bpy-env.sh --print VERSION" >&2; exit 2; }
   v="$(exact "$2")"
   echo "$cache/$v/bin/python"
-  [ -x "$cache/$v/bin/python" ]
+  ready "$cache/$v" "$v"
   exit $?
 fi
 
@@ -54,7 +66,7 @@ fi
 checked=""
 for v in "${wanted[@]}"; do
   final="$cache/$v"
-  if [ -x "$final/bin/python" ]; then
+  if ready "$final" "$v"; then
     continue
   fi
   if [ -z "$checked" ]; then
@@ -73,9 +85,11 @@ for v in "${wanted[@]}"; do
   # temporary folder: use `python -m pip`).
   trap 'rm -rf "$tmp"' EXIT
   "$python" -m venv "$tmp/venv"
-  "$tmp/venv/bin/python" -m pip install --quiet --no-input "bpy==$v"
+  requirements "$v" > "$tmp/requirements.txt"
+  "$tmp/venv/bin/python" -m pip install --quiet --no-input -r "$tmp/requirements.txt"
   "$tmp/venv/bin/python" -c 'import bpy, sys; print("bpy", bpy.app.version_string, file=sys.stderr)'
-  if [ ! -x "$final/bin/python" ]; then  # (another run may have finished it meanwhile)
+  cp "$tmp/requirements.txt" "$tmp/venv/$stamp"
+  if ! ready "$final" "$v"; then  # (another run may have finished it meanwhile)
     rm -rf "$final"
     mv "$tmp/venv" "$final"
   fi
