@@ -45,7 +45,8 @@ def main(args):
     scene.collection.objects.link(fractal)
 
     material = bpy.data.materials.new("dqjulia volume")
-    material.use_nodes = True
+    if bpy.app.version < (5, 0, 0):  # 5.0: always node-based, use_nodes is deprecated
+        material.use_nodes = True
     nodes, links = material.node_tree.nodes, material.node_tree.links
     nodes.clear()
     shader = nodes.new("ShaderNodeVolumePrincipled")
@@ -83,7 +84,8 @@ def main(args):
     sun.rotation_euler = Vector((0.6, -0.7, 0.8)).to_track_quat("Z", "Y").to_euler()
     scene.collection.objects.link(sun)
     world = bpy.data.worlds.new("sky")
-    world.use_nodes = True
+    if bpy.app.version < (5, 0, 0):
+        world.use_nodes = True
     world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.30, 0.36, 0.45, 1.0)
     world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.6
     scene.world = world

@@ -19,12 +19,34 @@ PREFIX = "dqjulia."
 _ROTATION = re.compile(r"^dqjulia\.rotations\[(\d+)\]\.degrees$")
 
 
-def dqjulia_fcurves(obj):
+def action_fcurves(obj, create=False):
+    """The F-curve collection that animates `obj` in its action, or None.
+
+    Blender 3.4 - 4.3: Action.fcurves. 4.4+: layered actions, whose F-curves live in the
+    channelbag of the object's action slot (Action.fcurves is deprecated in 4.4 and gone in 5.0).
+    `create`: make the channelbag if the slot has none yet (keyframe_insert makes it anyway)."""
     animation_data = obj.animation_data
     action = animation_data.action if animation_data else None
     if action is None:
+        return None
+    slot = getattr(animation_data, "action_slot", None)
+    if hasattr(action, "layers") and slot is not None:
+        from bpy_extras import anim_utils
+        channelbag = anim_utils.action_get_channelbag_for_slot(action, slot)
+        if channelbag is None and create and hasattr(anim_utils, "action_ensure_channelbag_for_slot"):
+            channelbag = anim_utils.action_ensure_channelbag_for_slot(action, slot)
+        if channelbag is not None:
+            return channelbag.fcurves
+        if not hasattr(action, "fcurves"):
+            return None
+    return getattr(action, "fcurves", None)
+
+
+def dqjulia_fcurves(obj):
+    fcurves = action_fcurves(obj)
+    if fcurves is None:
         return []
-    return [curve for curve in action.fcurves if curve.data_path.startswith(PREFIX)]
+    return [curve for curve in fcurves if curve.data_path.startswith(PREFIX)]
 
 
 def is_animated(obj):
@@ -85,17 +107,16 @@ def animation_section(obj):
 
 
 def clear(obj):
-    animation_data = obj.animation_data
-    if animation_data is None or animation_data.action is None:
+    fcurves = action_fcurves(obj)
+    if fcurves is None:
         return
-    action = animation_data.action
-    for curve in [curve for curve in action.fcurves if curve.data_path.startswith(PREFIX)]:
-        action.fcurves.remove(curve)
+    for curve in [curve for curve in fcurves if curve.data_path.startswith(PREFIX)]:
+        fcurves.remove(curve)
 
 
 def _set_interpolation(obj, data_path, index, frame, interpolation):
-    action = obj.animation_data.action
-    curve = action.fcurves.find(data_path, index=index)
+    fcurves = action_fcurves(obj)
+    curve = fcurves.find(data_path, index=index) if fcurves is not None else None
     if curve is None:
         return
     for point in curve.keyframe_points:

@@ -128,10 +128,18 @@ def _replace(context, source, kind, name, data, files):
     return obj
 
 
+def new_node_material(name):
+    """A new material with its node tree. Blender 5.0 deprecates Material.use_nodes (materials
+    always use nodes there, and touching the property warns): set it only before 5.0."""
+    material = bpy.data.materials.new(name)
+    if bpy.app.version < (5, 0, 0):
+        material.use_nodes = True
+    return material
+
+
 def principled_volume_material(name):
     """A new node material of one Principled Volume wired to the output: (material, volume node)."""
-    material = bpy.data.materials.new(name)
-    material.use_nodes = True
+    material = new_node_material(name)
     tree = material.node_tree
     tree.nodes.clear()
     output = tree.nodes.new("ShaderNodeOutputMaterial")
@@ -204,8 +212,7 @@ def build_volume(context, source, path, sequence=None):
 
 
 def mesh_material(name, with_colors):
-    material = bpy.data.materials.new(name)
-    material.use_nodes = True
+    material = new_node_material(name)
     tree = material.node_tree
     bsdf = next((node for node in tree.nodes if node.type == "BSDF_PRINCIPLED"), None)
     if bsdf is not None and with_colors:
@@ -229,8 +236,10 @@ def build_mesh(context, source, data):
         mesh.loops.add(3 * triangles)
         mesh.loops.foreach_set("vertex_index", data.triangles)
         mesh.polygons.add(triangles)
+        # loop_total is read-only since 3.6: Blender derives it from the next face's loop_start.
         mesh.polygons.foreach_set("loop_start", array.array("i", range(0, 3 * triangles, 3)))
-        mesh.polygons.foreach_set("loop_total", array.array("i", [3]) * triangles)
+        if not bpy.types.MeshPolygon.bl_rna.properties["loop_total"].is_readonly:  # Blender 3.4 - 3.5
+            mesh.polygons.foreach_set("loop_total", array.array("i", [3]) * triangles)
         mesh.polygons.foreach_set("use_smooth", array.array("b", [1]) * triangles)
         mesh.update(calc_edges=True)
         if hasattr(mesh, "use_auto_smooth"):  # Blender < 4.1: custom normals need auto smooth

@@ -32,8 +32,19 @@ def preset_names():
     return sorted(os.path.splitext(name)[0] for name in os.listdir(PRESET_DIR) if name.endswith(".json"))
 
 
+# Blender keeps only pointers to the strings a dynamic EnumProperty's items callback returns:
+# Python must keep them alive, or menus show garbage or crash (bpy.props.EnumProperty's docs).
+# The list is made once per set of preset files and kept here.
+_PRESET_ITEMS = {"names": None, "items": [("", "(no presets)", "")]}
+
+
 def _preset_items(_self, _context):
-    return [(name, name, "examples/%s.json" % name) for name in preset_names()] or [("", "(no presets)", "")]
+    names = tuple(preset_names())
+    if names != _PRESET_ITEMS["names"]:
+        _PRESET_ITEMS["names"] = names
+        _PRESET_ITEMS["items"] = ([(name, name, "examples/%s.json" % name) for name in names]
+                                  or [("", "(no presets)", "")])
+    return _PRESET_ITEMS["items"]
 
 
 def load_params_into(obj, path):

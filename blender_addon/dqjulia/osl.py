@@ -74,6 +74,25 @@ def sync_node(node, obj):
             socket.default_value = value
 
 
+def use_cycles_osl(scene):
+    """Cycles on the CPU with Open Shading Language: what the Script node needs to run."""
+    scene.render.engine = "CYCLES"
+    cycles = getattr(scene, "cycles", None)
+    if cycles is not None:
+        cycles.shading_system = True
+        cycles.device = "CPU"  # OSL runs on the CPU (and OptiX) only
+
+
+def node_tree_of(material):
+    """The material's node tree, or None. Blender 5.0 deprecates Material.use_nodes (always on;
+    reading it warns each time): there, the tree alone says."""
+    if material is None:
+        return None
+    if bpy.app.version < (5, 0, 0) and not material.use_nodes:
+        return None
+    return material.node_tree
+
+
 def add_volume(context, source):
     """A cube over the bounds with the OSL volume material, parented to the source."""
     values = input_values(source)
@@ -84,6 +103,9 @@ def add_volume(context, source):
     faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
     mesh.from_pydata(corners, [], faces)  # 8 corners: the mesh bakes use foreach_set
     mesh.update()
+    # Blender compiles a Script node's OSL (and gives it its sockets) only when the scene
+    # already renders with Cycles and OSL on: switch first, then assign the script.
+    use_cycles_osl(context.scene)
     material, volume = bakes.principled_volume_material("%s OSL" % source.name)
     tree = material.node_tree
     script = tree.nodes.new("ShaderNodeScript")
@@ -94,7 +116,13 @@ def add_volume(context, source):
         bpy.data.materials.remove(material)
         bpy.data.meshes.remove(mesh)
         raise RuntimeError("Cycles did not compile the OSL script (no outputs); see the console")
-    tree.links.new(script.outputs["Density"], volume.inputs["Density"])
+    # The same density scale as a baked volume's material, so both render alike.
+    scale = tree.nodes.new("ShaderNodeMath")
+    scale.operation = "MULTIPLY"
+    scale.location = (-150, 0)
+    scale.inputs[1].default_value = bakes.VOLUME_DENSITY_SCALE
+    tree.links.new(script.outputs["Density"], scale.inputs[0])
+    tree.links.new(scale.outputs["Value"], volume.inputs["Density"])
     sync_node(script, source)
     mesh.materials.append(material)
     obj = bpy.data.objects.new(mesh.name, mesh)
@@ -103,9 +131,6 @@ def add_volume(context, source):
     obj.matrix_parent_inverse.identity()
     obj.matrix_basis.identity()
     obj[SOURCE_KEY] = source.name
-    context.scene.render.engine = "CYCLES"
-    if hasattr(context.scene, "cycles"):
-        context.scene.cycles.shading_system = True
     return obj
 
 
@@ -118,10 +143,10 @@ def _sync_all(scene, _depsgraph=None):
         if source is None or obj.type != "MESH":
             continue
         for slot in obj.material_slots:
-            material = slot.material
-            if material is None or not material.use_nodes:
+            tree = node_tree_of(slot.material)
+            if tree is None:
                 continue
-            for node in material.node_tree.nodes:
+            for node in tree.nodes:
                 if node.bl_idname == "ShaderNodeScript":
                     try:
                         sync_node(node, source)

@@ -1,9 +1,24 @@
 # One Blender test: makes a file with the real dqjulia, then checks it in the real Blender.
 #   cmake -DCLI=dqjulia -DBLENDER=blender -DSCRIPTS=tests/blender -DWORK=folder -DEXAMPLES=examples
 #         -DMODE=vdb|sequence|ply|obj -P blender_test.cmake
+#   ... -DPYTHON=VENV/bin/python -DBPY_VERSION=4.5.15 ...: check in a bpy wheel's venv instead
+#   (skipped, or failing when CI=true, if the venv is missing: run_blender.cmake's rule).
 # The dqjulia run uses small resolutions so the whole check takes seconds.
+if(PYTHON AND NOT EXISTS "${PYTHON}")
+  set(reason "the bpy ${BPY_VERSION} venv is missing (${PYTHON}): run scripts/bpy-env.sh ${BPY_VERSION}")
+  if("$ENV{CI}" STREQUAL "true")
+    message(FATAL_ERROR "${reason} (CI=true: the bpy tests must run)")
+  endif()
+  message("DQJ_TEST_SKIPPED: ${reason}")
+  return()
+endif()
 file(REMOVE_RECURSE "${WORK}")
 file(MAKE_DIRECTORY "${WORK}")
+foreach(kind RESOURCES CONFIG SCRIPTS DATAFILES EXTENSIONS)  # scratch user folders
+  string(TOLOWER "${kind}" folder)
+  file(MAKE_DIRECTORY "${WORK}/user/${folder}")
+  set(ENV{BLENDER_USER_${kind}} "${WORK}/user/${folder}")
+endforeach()
 
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE status OUTPUT_VARIABLE out ERROR_VARIABLE err)
@@ -13,7 +28,11 @@ function(run)
   set(out "${out}" PARENT_SCOPE)
 endfunction()
 
-set(blender ${BLENDER} -b --factory-startup --python-exit-code 1 --python)
+if(PYTHON)
+  set(blender ${PYTHON})
+else()
+  set(blender ${BLENDER} -b --factory-startup --python-exit-code 1 --python)
+endif()
 if(MODE STREQUAL "vdb")
   run(${CLI} bake -q -r 32 --grids surface,density,color,trap,iterations -o ${WORK}/fractal.vdb)
   run(${blender} ${SCRIPTS}/check_vdb.py -- ${WORK}/fractal.vdb surface,density,color,trap,iterations)

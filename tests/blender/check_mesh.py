@@ -17,7 +17,10 @@ def main(argv):
     path, vertices, faces = argv[0], int(argv[1]), int(argv[2])
     before = set(bpy.data.objects)
     if path.endswith(".ply"):
-        bpy.ops.import_mesh.ply(filepath=path)      # Blender 3.4: the PLY add-on
+        if "ply_import" in dir(bpy.ops.wm):  # (hasattr is always true on bpy.ops)
+            bpy.ops.wm.ply_import(filepath=path)    # Blender 3.6+: the C++ PLY importer
+        else:
+            bpy.ops.import_mesh.ply(filepath=path)  # Blender 3.4 - 3.5: the PLY add-on (gone in 4.0)
     else:
         bpy.ops.wm.obj_import(filepath=path)        # Blender 3.4: the C++ OBJ importer
     added = [obj for obj in bpy.data.objects if obj not in before]

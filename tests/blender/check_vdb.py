@@ -49,7 +49,10 @@ def main(argv):
         if not volume.is_sequence or volume.frame_duration != count or volume.frame_start != 1:
             fail(f"not a sequence of {count} frames from frame 1: is_sequence={volume.is_sequence}, "
                  f"frame_start={volume.frame_start}, frame_duration={volume.frame_duration}")
-        for frame in range(1, count + 1):
+        # Last frame first: each check follows a real frame change. Blender 4.2 (bpy 4.2.23)
+        # reports "NAME_0000.vdb not found" for a sequence that has not seen a frame change
+        # since it was made (4.5, 5.0 and 3.4 load frame 1 at once).
+        for frame in range(count, 0, -1):
             scene.frame_set(frame)
             evaluated = obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data
             check_grids(evaluated, grids, f"frame {frame}")

@@ -1,14 +1,32 @@
-# Runs one Blender test script with fresh user folders (BLENDER_USER_CONFIG/SCRIPTS/DATAFILES
-# under USER), in a virtual X display when XVFB_RUN is given. Fails if Blender exits non-zero.
+# Runs one Blender test script with fresh user folders under USER, in a virtual X display when
+# XVFB_RUN is given. Fails if Blender exits non-zero.
 #   -DBLENDER= -DUSER= -DSCRIPT= "-DBLENDER_ARGS=a;b" "-DSCRIPT_ARGS=a;b" [-DXVFB_RUN=]
+#   -DPYTHON= -DBPY_VERSION= -DUSER= -DSCRIPT= "-DSCRIPT_ARGS=a;b"
+# The second form runs the script in a bpy wheel's venv (scripts/bpy-env.sh): `import bpy`
+# is Blender. If that venv is missing the test fails saying why when CI=true, and is skipped
+# otherwise (it prints DQJ_TEST_SKIPPED, the test's SKIP_REGULAR_EXPRESSION).
+# BLENDER_USER_RESOURCES (4.2+: every user folder), CONFIG, SCRIPTS, DATAFILES and EXTENSIONS
+# (4.2+) all point into USER, never at the real user's folders.
 cmake_minimum_required(VERSION 3.25)
+if(PYTHON AND NOT EXISTS "${PYTHON}")
+  set(reason "the bpy ${BPY_VERSION} venv is missing (${PYTHON}): run scripts/bpy-env.sh ${BPY_VERSION}")
+  if("$ENV{CI}" STREQUAL "true")
+    message(FATAL_ERROR "${reason} (CI=true: the bpy tests must run)")
+  endif()
+  message("DQJ_TEST_SKIPPED: ${reason}")
+  return()
+endif()
 file(REMOVE_RECURSE "${USER}")
-foreach(kind CONFIG SCRIPTS DATAFILES)
+foreach(kind RESOURCES CONFIG SCRIPTS DATAFILES EXTENSIONS)
   string(TOLOWER "${kind}" folder)
   file(MAKE_DIRECTORY "${USER}/${folder}")
   set(ENV{BLENDER_USER_${kind}} "${USER}/${folder}")
 endforeach()
-set(command "${BLENDER}" ${BLENDER_ARGS} --python "${SCRIPT}" -- ${SCRIPT_ARGS})
+if(PYTHON)
+  set(command "${PYTHON}" "${SCRIPT}" -- ${SCRIPT_ARGS})
+else()
+  set(command "${BLENDER}" ${BLENDER_ARGS} --python "${SCRIPT}" -- ${SCRIPT_ARGS})
+endif()
 if(XVFB_RUN)
   set(command "${XVFB_RUN}" -a -s "-screen 0 1280x800x24" ${command})
 endif()
