@@ -177,9 +177,9 @@ def _load():
         library = ctypes.CDLL(path)
     except OSError as error:
         raise NativeUnavailable(
-            "the dqjulia native library at %s could not be loaded (%s). It is built for Linux x86-64 with the "
-            "Debian 12 libraries (TBB, OpenEXR, libpng, OpenVDB): install them, or rebuild the add-on on "
-            "this machine" % (path, error))
+            "the dqjulia native library at %s could not be loaded (%s). It is self-contained and needs only "
+            "Linux x86-64 with glibc 2.34 or newer (Debian 12, Ubuntu 22.04, RHEL 9 or later); on another "
+            "system, build the add-on there (README, Two commands)" % (path, error))
     try:
         version_number = library.dqj_version_number
     except AttributeError:
