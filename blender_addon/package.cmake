@@ -9,6 +9,15 @@ file(MAKE_DIRECTORY "${STAGE}/dqjulia/lib" "${STAGE}/dqjulia/presets")
 file(COPY "${SOURCE}/" DESTINATION "${STAGE}/dqjulia"
      PATTERN "__pycache__" EXCLUDE PATTERN "*.pyc" EXCLUDE)
 file(COPY "${BUILDINFO}" DESTINATION "${STAGE}/dqjulia")
+# The project's version (VERSION) into the manifest (4.2+) and bl_info (3.4 - 4.1), which Blender
+# reads as literals without running the add-on. tests/version_test.py checks the zip's.
+string(REPLACE "." ", " version_tuple "${VERSION}")
+file(READ "${STAGE}/dqjulia/blender_manifest.toml" text)
+string(REGEX REPLACE "\nversion = \"[0-9.]+\"" "\nversion = \"${VERSION}\"" text "${text}")
+file(WRITE "${STAGE}/dqjulia/blender_manifest.toml" "${text}")
+file(READ "${STAGE}/dqjulia/__init__.py" text)
+string(REGEX REPLACE "\"version\": \\([0-9, ]+\\)" "\"version\": (${version_tuple})" text "${text}")
+file(WRITE "${STAGE}/dqjulia/__init__.py" "${text}")
 file(GLOB examples "${EXAMPLES}/*.json")
 file(COPY ${examples} DESTINATION "${STAGE}/dqjulia/presets")
 file(COPY_FILE "${LIBRARY}" "${STAGE}/dqjulia/lib/libdqjulia.so")

@@ -28,10 +28,10 @@
 extern "C" {
 #endif
 
-/* Version of the header you compile against; compare with dqj_version_number() at run time. */
-#define DQJ_VERSION_MAJOR 0
-#define DQJ_VERSION_MINOR 1
-#define DQJ_VERSION_PATCH 0
+/* Version of the header you compile against (DQJ_VERSION_MAJOR, _MINOR, _PATCH and
+ * DQJ_VERSION_STRING, from the project's VERSION file); compare with dqj_version_number()
+ * at run time. */
+#include "dqjulia/version.h"
 #define DQJ_VERSION_NUMBER (DQJ_VERSION_MAJOR * 10000 + DQJ_VERSION_MINOR * 100 + DQJ_VERSION_PATCH)
 
 /* MAJOR*10000 + MINOR*100 + PATCH of the library actually loaded. */
