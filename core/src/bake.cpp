@@ -40,6 +40,16 @@ private:
     const std::atomic<bool>& stop_;
 };
 
+/// OpenVDB's file writer, aimed at AtomicFile's checked stream. io::File::write opens its own
+/// std::ofstream and never checks it (a full disk gave a truncated file and no error);
+/// Archive's seekable stream writer is what io::File::write calls, so the bytes are the same.
+class CheckedVdbWriter : public openvdb::io::Archive {
+public:
+    void write(std::ostream& out, const openvdb::GridPtrVec& grids, const openvdb::MetaMap& metadata) const {
+        openvdb::io::Archive::write(out, grids, /*seekable=*/true, metadata);
+    }
+};
+
 /// Memory per sampled 8^3 leaf beyond the sampled leaf itself: the rebuild's mesh and distance
 /// grids, the level set, the fog volume; attribute grids on top. Measured on the default
 /// fractal (peak RSS minus the 65 MB of a tiny bake, over sampled leaves: 4.3 kB at 256^3,
@@ -190,7 +200,7 @@ BakeStats bakeVdb(const Params& params, const std::string& path, const BakeOptio
     const auto start = std::chrono::steady_clock::now();
     validate(params);
     if (AtomicFile::lowercaseExtension(path) != ".vdb") throw ParamError("output.path", "'" + path + "' must end in .vdb");
-    AtomicFile file(path);  // fails now, before the work, if the folder is not writable
+    AtomicFile file(path, options.existing);  // fails now, before the work, if the folder is not writable
     StagedProgress staged(progress, options.monitor);
     BakeStats stats;
     openvdb::FloatGrid::Ptr surface = bakeLevelSet(params, options, bakeMemoryModel(params.bake), staged, stats, 0.7, 0.85);
@@ -214,10 +224,9 @@ BakeStats bakeVdb(const Params& params, const std::string& path, const BakeOptio
     metadata.insertMeta("dqjulia_parameters", openvdb::StringMetadata(toJson(params)));
     metadata.insertMeta("dqjulia_voxel_size", openvdb::DoubleMetadata(stats.voxelSize));
     try {
-        openvdb::io::File vdb(file.tempPath());
-        vdb.write(grids, metadata);
-        vdb.close();
+        CheckedVdbWriter().write(file.stream(), grids, metadata);
     } catch (const openvdb::Exception& error) {
+        if (!file.stream()) file.commit();  // throws with the write's reason ("No space left on device")
         throw std::runtime_error(AtomicFile::failureMessage(path, error.what()));
     }
     file.commit();
