@@ -8,7 +8,11 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <set>
 #include <sstream>
+
+#include <fcntl.h>
+#include <unistd.h>
 
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
@@ -18,7 +22,7 @@
 namespace dqj {
 
 ParamError::ParamError(std::string key, const std::string& message)
-    : std::runtime_error(message), key_(std::move(key)) {}
+    : std::runtime_error(printableText(message)), key_(std::move(key)) {}
 
 namespace {
 
@@ -39,10 +43,94 @@ std::size_t editDistance(const std::string& a, const std::string& b) {
     return previous[b.size()];
 }
 
-std::string describe(const Json& value) {
-    std::string text = value.dump();
-    if (text.size() > 40) text = text.substr(0, 37) + "...";
-    return std::string(value.type_name()) + " " + text;
+/// The first characters of `value` as JSON, written without recursion (a value may be nested
+/// as deep as the parser allows) and without serialising more than is shown.
+std::string preview(const Json& value, std::size_t limit) {
+    struct Frame {
+        const Json* node;
+        Json::const_iterator next;
+    };
+    std::string text;
+    std::vector<Frame> stack;
+    auto open = [&](const Json& node) {
+        if (!node.is_structured()) {
+            text += node.dump();
+            return;
+        }
+        text += node.is_object() ? '{' : '[';
+        stack.push_back({&node, node.begin()});
+    };
+    open(value);
+    while (!stack.empty() && text.size() <= limit) {
+        Frame& frame = stack.back();
+        if (frame.next == frame.node->end()) {
+            text += frame.node->is_object() ? '}' : ']';
+            stack.pop_back();
+            continue;
+        }
+        if (frame.next != frame.node->begin()) text += ',';
+        const auto item = frame.next++;
+        if (frame.node->is_object()) text += Json(item.key()).dump() + ":";
+        open(*item);  // may invalidate `frame`
+    }
+    if (text.size() > limit) text = text.substr(0, limit - 3) + "...";
+    return text;
+}
+
+std::string describe(const Json& value) { return std::string(value.type_name()) + " " + preview(value, 40); }
+
+/// Parses JSON with the limits of the format: at most kMaxParamsDepth levels of arrays and
+/// objects (deeper documents are refused before they can exhaust a stack) and no key twice in
+/// one object (nlohmann keeps the last silently). Errors name the dotted path of the key.
+Json parseLimited(const std::string& text, const std::string& source) {
+    struct Frame {
+        bool object;
+        std::size_t elements = 0;  // arrays: elements started so far
+        std::string key;           // objects: the current key
+        std::set<std::string> keys;
+    };
+    std::vector<Frame> frames;
+    auto path = [&](const std::string& last) {
+        std::string result;
+        for (const Frame& frame : frames) {
+            if (&frame == &frames.back() && frame.object) break;
+            if (frame.object)
+                result += (result.empty() ? "" : ".") + frame.key;
+            else if (frame.elements > 0)
+                result += "[" + std::to_string(frame.elements - 1) + "]";
+        }
+        return result.empty() ? last : last.empty() ? result : result + "." + last;
+    };
+    auto elementStarts = [&] {
+        if (!frames.empty() && !frames.back().object) ++frames.back().elements;
+    };
+    using Event = Json::parse_event_t;
+    return Json::parse(text, [&](int, Event event, Json& parsed) {
+        switch (event) {
+            case Event::object_start:
+            case Event::array_start:
+                elementStarts();
+                if (frames.size() >= std::size_t(kMaxParamsDepth))
+                    throw ParamError("", source + ": arrays and objects nested deeper than " + std::to_string(kMaxParamsDepth) +
+                                             " levels; a parameter file needs at most 4");
+                frames.push_back({event == Event::object_start});
+                break;
+            case Event::key: {
+                Frame& frame = frames.back();
+                frame.key = parsed.get<std::string>();
+                if (!frame.keys.insert(frame.key).second) {
+                    const std::string key = path(frame.key);
+                    throw ParamError(key, source + ": " + key + ": duplicate key \"" + frame.key +
+                                              "\" (a key may appear once in an object; the second would replace the first)");
+                }
+                break;
+            }
+            case Event::object_end:
+            case Event::array_end: frames.pop_back(); break;
+            case Event::value: elementStarts(); break;
+        }
+        return true;
+    });
 }
 
 std::string formatNumber(double value) {
@@ -171,7 +259,7 @@ Enum parseChoice(ObjectReader& reader, const Json& value, const std::string& key
     if (!value.is_string()) reader.fail(key, "must be one of " + allowed + ", got " + describe(value));
     for (const auto& [name, choice] : choices)
         if (value.get<std::string>() == name) return choice;
-    reader.fail(key, "must be one of " + allowed + ", got \"" + value.get<std::string>() + "\"");
+    reader.fail(key, "must be one of " + allowed + ", got " + value.dump());
 }
 
 constexpr std::array<std::pair<std::string_view, Variant>, 3> kVariants{
@@ -500,9 +588,12 @@ bool parallel(const glm::dvec3& a, const glm::dvec3& b) {
 }  // namespace
 
 Params parseParams(const std::string& jsonText, const std::string& source, Validation validation) {
+    if (jsonText.size() > kMaxParamsBytes)
+        throw ParamError("", source + ": the document has more than " + std::to_string(kMaxParamsBytes >> 20) +
+                                 " MiB; a parameter file is a few kilobytes");
     Json document;
     try {
-        document = Json::parse(jsonText);
+        document = parseLimited(jsonText, source);
     } catch (const Json::parse_error& error) {
         std::string reason = error.what();
         const std::size_t colon = reason.find(": ");  // drop "[json.exception.parse_error.101] parse error at ...: "
@@ -547,12 +638,26 @@ Params parseParams(const std::string& jsonText, const std::string& source, Valid
 }
 
 Params loadParams(const std::string& path, Validation validation) {
-    std::ifstream file(path, std::ios::binary);
-    if (!file) throw ParamError("", "cannot read parameter file '" + path + "': " + std::strerror(errno));
-    std::ostringstream text;
-    text << file.rdbuf();
-    if (file.bad()) throw ParamError("", "cannot read parameter file '" + path + "'");
-    return parseParams(text.str(), path, validation);
+    auto fail = [&](const std::string& reason) { return ParamError("", "cannot read parameter file '" + path + "': " + reason); };
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) throw fail(std::strerror(errno));
+    // Read at most one byte beyond the limit, so a never-ending file (/dev/zero, a stalled
+    // pipe's writer) cannot grow the buffer without bound. A signal (Ctrl-C) ends the read.
+    std::string text;
+    char chunk[65536];
+    int error = 0;
+    while (text.size() <= kMaxParamsBytes) {
+        const ssize_t got = ::read(fd, chunk, sizeof chunk);
+        if (got < 0) error = errno;
+        if (got <= 0) break;
+        text.append(chunk, std::size_t(got));
+    }
+    ::close(fd);
+    if (error == EINTR) throw fail("interrupted");
+    if (error) throw fail(std::strerror(error));
+    if (text.size() > kMaxParamsBytes)
+        throw fail("larger than " + std::to_string(kMaxParamsBytes >> 20) + " MiB; a parameter file is a few kilobytes");
+    return parseParams(text, path, validation);
 }
 
 void validate(const Params& params) {
@@ -577,10 +682,35 @@ void validate(const Params& params) {
     const Stretch stretch = stretchOf(slice);
     if (stretch.min < 1e-9 * std::max(1.0, stretch.max))
         fail("slice.axes", "the three axes are zero or parallel, so the slice is not 3-D; give three independent axes");
+    // Linearly dependent axes (z = x + y) span a plane: the Gram determinant vanishes against
+    // the product of the squared lengths (Hadamard's bound; 1 for orthogonal axes).
+    {
+        double gram[3][3] = {};
+        for (int row = 0; row < 3; ++row)
+            for (int column = 0; column < 3; ++column)
+                for (int index = 0; index < 8; ++index) gram[row][column] += slice.axes[row][index] * slice.axes[column][index];
+        const double determinant = gram[0][0] * (gram[1][1] * gram[2][2] - gram[1][2] * gram[2][1]) -
+                                   gram[0][1] * (gram[1][0] * gram[2][2] - gram[1][2] * gram[2][0]) +
+                                   gram[0][2] * (gram[1][0] * gram[2][1] - gram[1][1] * gram[2][0]);
+        if (!(determinant > 1e-10 * gram[0][0] * gram[1][1] * gram[2][2]))
+            fail("slice.axes", "the three axes are linearly dependent (one is a combination of the others), so the slice "
+                               "is a plane, not 3-D; give three independent axes");
+    }
 
     if (params.bounds && !(params.bounds->radius > 0.0)) fail("bounds.radius", "must be greater than 0");
 
+    auto finite3 = [](const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+    if (params.bounds && (!finite3(params.bounds->center) || !std::isfinite(params.bounds->radius)))
+        fail("bounds", "center and radius must be finite numbers");
     const Camera& camera = params.camera;
+    if (camera.position && !finite3(*camera.position)) fail("camera.position", "must be 3 finite numbers");
+    if (camera.target && !finite3(*camera.target)) fail("camera.target", "must be 3 finite numbers");
+    if (!finite3(camera.direction)) fail("camera.direction", "must be 3 finite numbers");
+    if (!finite3(camera.up)) fail("camera.up", "must be 3 finite numbers");
+    for (std::size_t index = 0; index < params.lights.size(); ++index)
+        if (!finite3(params.lights[index].direction) || !finite3(params.lights[index].color) ||
+            !std::isfinite(params.lights[index].intensity))
+            fail("lights[" + std::to_string(index) + "]", "direction, color and intensity must be finite numbers");
     if (!(camera.fovDegrees > 0.0 && camera.fovDegrees < 170.0)) fail("camera.fov", "must be between 0 and 170 degrees");
     if (glm::length(camera.up) == 0.0) fail("camera.up", "must not be the zero vector");
     glm::dvec3 forward;
@@ -742,14 +872,10 @@ std::string toJson(const Params& params) {
     return compactNumberArrays(document.dump(2)) + "\n";
 }
 
-void saveParams(const Params& params, const std::string& path) {
-    AtomicFile target(path);
-    {
-        std::ofstream file(target.tempPath(), std::ios::binary | std::ios::trunc);
-        file << toJson(params);
-        file.flush();
-        if (!file) throw std::runtime_error(AtomicFile::failureMessage(path, std::strerror(errno)));
-    }
+void saveParams(const Params& params, const std::string& path, Existing existing) {
+    const std::string text = toJson(params);
+    AtomicFile target(path, existing);
+    target.stream() << text;
     target.commit();
 }
 
