@@ -229,7 +229,8 @@ void AtomicFile::commit() {
         throw systemError(path_, state.buffer->error() ? state.buffer->error() : EIO);
     // Keep the mode of a file being replaced; a new file gets 0666 minus the umask, as open()
     // would give it (O_TMPFILE already applied the umask, mkstemp did not).
-    const int oldMode = existingMode(path_, state.existing);
+    // (With Keep, a file that appeared meanwhile is found by the no-replace publishing below.)
+    const int oldMode = state.existing == Existing::Keep ? -1 : existingMode(path_, Existing::Replace);
     const mode_t mode = oldMode >= 0 ? mode_t(oldMode) : (0666 & ~currentUmask());
     if (::fchmod(state.fd, mode) != 0 || ::fsync(state.fd) != 0) throw systemError(path_, errno);
 

@@ -135,7 +135,7 @@ public:
         const std::uint64_t processLimit = processMemoryHeadroom();
         const std::uint64_t requested = options.memoryLimit ? options.memoryLimit : defaultMemoryLimit();
         limit_ = std::min(requested, processLimit);
-        processLimited_ = limit_ == processLimit && processLimit < requested;
+        processLimited_ = processLimit <= requested;  // defaultMemoryLimit() too may be the process limit
         limitSource_ = processLimited_ ? " (what this process may still allocate under its memory limits: ulimit -v, "
                                                 "ulimit -d or its cgroup's memory.max)"
                        : options.memoryLimit ? ""
