@@ -154,7 +154,7 @@ SceneFacts resolve(const Params& params) {
 void writeHeader(std::ostringstream& out, const Params& params, const PovraySceneOptions& options,
                  const std::string& kind) {
     out << "// dqjulia scene for POV-Ray 3.7, written by `dqjulia povray` (dqjulia " << povString(DQJ_VERSION_STRING_FROM_BUILD)
-        << ")" << (options.sourceName.empty() ? "" : " from " + options.sourceName) << ".\n";
+        << ")" << (options.sourceName.empty() ? "" : " from " + povString(options.sourceName)) << ".\n";
     if (!params.description.empty()) out << commentBlock(params.description);
     out << "//\n" << commentBlock(kind);
     out << "//\n// Render (" << options.includeName
@@ -442,6 +442,14 @@ PovrayFiles povrayFiles(const Params& params, const std::string& scenePath, cons
     if (options.df3) {
         files.df3 = stem + ".df3";
         files.df3Scene = stem + "_df3.pov";
+        // The DF3 scene names the grid file in a POV-Ray string, which carries printable
+        // ASCII only (POV-Ray 3.7 reads strings as ASCII; quotes and backslashes are escapes).
+        for (const char ch : fs::path(files.df3).filename().string())
+            if (ch < 0x20 || ch > 0x7e || ch == '"' || ch == '\\')
+                throw ParamError("output.path", "'" + scenePath + "': with --df3 the scene names the grid file '" +
+                                                    fs::path(files.df3).filename().string() +
+                                                    "' in a POV-Ray string, which carries only printable ASCII "
+                                                    "characters without \" and \\; rename the scene");
     }
     if (options.copyInclude) files.include = (folder / "dqjulia.inc").string();
     return files;

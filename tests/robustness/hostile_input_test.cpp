@@ -249,6 +249,45 @@ TEST_F(Hostile, OutputsThatAreNotRegularFilesAreRefusedBeforeTheWork) {
     EXPECT_CONTAINS(result.err, "cannot write '/proc/dqjulia-test.vdb'");
 }
 
+// --- POV-Ray: names a scene string cannot carry, settings the include must refuse --------
+
+TEST_F(Hostile, Df3SceneNamesPovrayCannotCarryAreRefused) {
+    for (const std::string name : {"caf\xc3\xa9", "quote\"d", "back\\slash"}) {
+        const auto result = run("povray -q --df3 --df3-resolution 8 -o '" + (dir_ / (name + ".pov")).string() + "'");
+        EXPECT_EQ(result.exitCode, 2) << name << ": " << result.err;
+        EXPECT_CONTAINS(result.err, "carries only printable ASCII");
+        EXPECT_TRUE(filesIn(dir_).empty());
+    }
+    EXPECT_EQ(run("povray -q --df3 --df3-resolution 8 -o " + path("plain name.pov")).exitCode, 0);
+}
+
+TEST_F(Hostile, ThePovrayIncludeStopsOnInvalidSettings) {
+    if (std::system("command -v povray > /dev/null 2>&1") != 0) GTEST_SKIP() << "povray is not installed";
+    ASSERT_EQ(run("povray -q -o " + path("scene.pov")).exitCode, 0);  // writes dqjulia.inc beside it
+    struct Case {
+        const char* slice;
+        const char* bailout;
+        const char* threshold;
+        const char* message;
+    };
+    const Case cases[] = {
+        {"DQJ_Slice_Names(\"a.s,a.i,a.j\")", "1e999", "0.01", "the bailout R must be a finite number"},
+        {"array[4][8] {{0,0,0,0,0,0,0,0},{1,0,0,0,0,0,0,0},{0,1,0,0,0,0,0,0},{1,1,0,0,0,0,0,0}}", "4", "0.01",
+         "zero, parallel or linearly dependent"},
+        {"DQJ_Slice_Names(\"a.s,a.i,a.j\")", "4", "-0.01", "threshold must be 0 or more"},
+    };
+    for (const Case& test : cases) {
+        write("bad.pov", std::string("#version 3.7;\n#include \"dqjulia.inc\"\n") +
+                             "#declare C = array[8] {-0.39054, -0.58679, 0, 0, 0, 0.5632, 0, 0.05};\n#declare S = " +
+                             test.slice + ";\ncamera { location <0, 0, -4> look_at 0 }\nobject { DQJ_Isosurface(C, \"paper\", 6, " +
+                             test.bailout + ", S, " + test.threshold + ") pigment { rgb 1 } }\n");
+        const std::string command = "cd '" + dir_.string() + "' && povray +W8 +H6 -D +Ibad.pov +Obad.png > povray.txt 2>&1";
+        EXPECT_NE(std::system(command.c_str()), 0) << test.message;
+        EXPECT_CONTAINS(readFile(dir_ / "povray.txt"), test.message);
+        EXPECT_FALSE(fs::exists(dir_ / "bad.png"));
+    }
+}
+
 // --- Signals and crashes -----------------------------------------------------------------
 
 TEST_F(Hostile, SighupStopsABakeLikeSigtermAndSigkillLeavesNoTemporaryFile) {
