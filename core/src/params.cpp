@@ -84,7 +84,7 @@ std::string describe(const Json& value) { return std::string(value.type_name()) 
 /// one object (nlohmann keeps the last silently). Errors name the dotted path of the key.
 Json parseLimited(const std::string& text, const std::string& source) {
     struct Frame {
-        bool object;
+        bool object = false;
         std::size_t elements = 0;  // arrays: elements started so far
         std::string key;           // objects: the current key
         std::set<std::string> keys;
@@ -113,7 +113,8 @@ Json parseLimited(const std::string& text, const std::string& source) {
                 if (frames.size() >= std::size_t(kMaxParamsDepth))
                     throw ParamError("", source + ": arrays and objects nested deeper than " + std::to_string(kMaxParamsDepth) +
                                              " levels; a parameter file needs at most 4");
-                frames.push_back({event == Event::object_start});
+                frames.emplace_back();
+                frames.back().object = event == Event::object_start;
                 break;
             case Event::key: {
                 Frame& frame = frames.back();
