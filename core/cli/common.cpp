@@ -118,6 +118,9 @@ void checkOutputPath(const std::string& path, bool force, const std::string& fla
     if (path.empty()) throw ParamError("output.path", flag + " is empty; give a file name");
     if (fs::is_directory(target, error))
         throw ParamError("output.path", flag + " '" + path + "' is a folder; give a file name");
+    if (fs::exists(target, error) && !fs::is_regular_file(target, error))
+        throw ParamError("output.path", flag + " '" + path + "' is not a regular file (a device, FIFO or socket); "
+                                        "dqjulia writes only regular files");
     if (fs::exists(target, error) && !force)
         throw ParamError("output.path", flag + " '" + path + "' exists; pass --force to overwrite it");
     const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");

@@ -737,9 +737,9 @@ void validate(const Params& params) {
         fail("render.width", "width and height must be from 1 to 16384");
     if (render.samples < 1 || render.samples > 16) fail("render.samples", "must be from 1 to 16");
     if (!(render.stepFactor > 0.0 && render.stepFactor <= 1.0)) fail("render.step_factor", "must be greater than 0 and at most 1");
-    if (!(render.maxStep > 0.0)) fail("render.max_step", "must be greater than 0");
+    if (!(render.maxStep > 0.0) || !std::isfinite(render.maxStep)) fail("render.max_step", "must be a finite number greater than 0");
     if (render.maxSteps < 1) fail("render.max_steps", "must be at least 1");
-    if (!(render.detail > 0.0)) fail("render.detail", "must be greater than 0");
+    if (!(render.detail > 0.0) || !std::isfinite(render.detail)) fail("render.detail", "must be a finite number greater than 0");
     if (render.normals == NormalMethod::Analytic && fractal.variant != Variant::Dual)
         fail("render.normals", "\"analytic\" normals come from the dual part of the true algebra and need variant \"dual\"; "
                                "use \"central\" or \"auto\" with variant \"" + std::string(variantName(fractal.variant)) + "\"");
