@@ -405,6 +405,12 @@ dqj_status dqj_render_to_file(dqj_context context, const char* path, dqj_progres
         dqj::Params params = paramsNow(self);
         params.output.path = path;
         dqj::validate(params);
+        try {
+            dqj::checkWritable(path);  // before the work, not after it
+        } catch (const std::exception& error) {
+            self.error = error.what();
+            return DQJ_ERROR_IO;
+        }
         const dqj::RenderResult result = dqj::render(params, wrapProgress(progress, userData));
         try {
             dqj::writeImage(result.image, path, dqj::formatFor(params.output));

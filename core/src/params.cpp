@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -134,10 +135,12 @@ Json parseLimited(const std::string& text, const std::string& source) {
     });
 }
 
+/// The shortest text that reads back as exactly `value`, so a message never shows a value
+/// rounded onto its limit ("must be at most 1, got 1" for 1.0000001).
 std::string formatNumber(double value) {
-    std::ostringstream out;
-    out << value;
-    return out.str();
+    char text[64];
+    const auto result = std::to_chars(text, text + sizeof text, value);
+    return std::string(text, result.ptr);
 }
 
 /// Walks one JSON object: reads known keys with type and range checks, then rejects any key
