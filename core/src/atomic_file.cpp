@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -119,7 +120,8 @@ std::string hiddenPrefix(const std::string& path) {
 }
 
 /// Removes ".name.tmp-*" files in the folder that no live writer holds locked: what a writer
-/// killed between creating and publishing its hidden file left behind.
+/// killed between creating and publishing its hidden file left behind. Files changed in the last
+/// few seconds are left alone: a writer locks its file just after creating it.
 void removeStaleTemporaries(const std::string& folder, const std::string& prefix) {
     DIR* directory = ::opendir(folder.c_str());
     if (!directory) return;
@@ -130,7 +132,9 @@ void removeStaleTemporaries(const std::string& folder, const std::string& prefix
         const int fd = ::open(stale.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
         if (fd < 0) continue;
         struct stat info {};
-        if (::fstat(fd, &info) == 0 && S_ISREG(info.st_mode) && ::flock(fd, LOCK_EX | LOCK_NB) == 0) ::unlink(stale.c_str());
+        if (::fstat(fd, &info) == 0 && S_ISREG(info.st_mode) && info.st_mtime + 5 < std::time(nullptr) &&
+            ::flock(fd, LOCK_EX | LOCK_NB) == 0)
+            ::unlink(stale.c_str());
         ::close(fd);
     }
     ::closedir(directory);
