@@ -704,13 +704,16 @@ void validate(const Params& params) {
     if (params.bounds && !(params.bounds->radius > 0.0)) fail("bounds.radius", "must be greater than 0");
 
     auto finite3 = [](const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+    // Camera vectors within the parameter file's range (+-1e9), so lengths and directions
+    // computed from them stay finite and exact enough to aim a ray.
+    auto sane3 = [&](const glm::dvec3& v) { return finite3(v) && std::abs(v.x) <= 1e9 && std::abs(v.y) <= 1e9 && std::abs(v.z) <= 1e9; };
     if (params.bounds && (!finite3(params.bounds->center) || !std::isfinite(params.bounds->radius)))
         fail("bounds", "center and radius must be finite numbers");
     const Camera& camera = params.camera;
-    if (camera.position && !finite3(*camera.position)) fail("camera.position", "must be 3 finite numbers");
-    if (camera.target && !finite3(*camera.target)) fail("camera.target", "must be 3 finite numbers");
-    if (!finite3(camera.direction)) fail("camera.direction", "must be 3 finite numbers");
-    if (!finite3(camera.up)) fail("camera.up", "must be 3 finite numbers");
+    if (camera.position && !sane3(*camera.position)) fail("camera.position", "must be 3 finite numbers from -1e9 to 1e9");
+    if (camera.target && !sane3(*camera.target)) fail("camera.target", "must be 3 finite numbers from -1e9 to 1e9");
+    if (!sane3(camera.direction)) fail("camera.direction", "must be 3 finite numbers from -1e9 to 1e9");
+    if (!sane3(camera.up)) fail("camera.up", "must be 3 finite numbers from -1e9 to 1e9");
     for (std::size_t index = 0; index < params.lights.size(); ++index)
         if (!finite3(params.lights[index].direction) || !finite3(params.lights[index].color) ||
             !std::isfinite(params.lights[index].intensity))

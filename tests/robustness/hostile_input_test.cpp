@@ -204,6 +204,10 @@ TEST_F(Hostile, ANonFiniteCameraIsRejectedAndNotSaved) {
     EXPECT_EQ(result.exitCode, 2) << result.err;
     EXPECT_CONTAINS(result.err, "camera.position: must be 3 finite numbers");
     EXPECT_TRUE(filesIn(dir_).empty());
+    const auto far = run("render -q -W 8 -H 8 --camera-target 1e300 0 0 -o " + path("out.png"));
+    EXPECT_EQ(far.exitCode, 2) << far.err;
+    EXPECT_CONTAINS(far.err, "camera.target: must be 3 finite numbers from -1e9 to 1e9");
+    EXPECT_TRUE(filesIn(dir_).empty());
 }
 
 // --- Outputs: empty names, one file twice, no-clobber, non-regular files -----------------
