@@ -11,10 +11,14 @@
  *                            fails with ENOSPC after DQJ_FAULT_AFTER bytes;
  *                    fsync:  fsync fails with EIO;  close: close fails with EIO.
  *   DQJ_FAULT_AFTER  bytes allowed before writes fail (default 0)
+ *   DQJ_FAULT_NO_TMPFILE=1  open(O_TMPFILE) fails with EOPNOTSUPP, as on a file system
+ *                    without it, so the writer's fallback (a hidden, locked name) is tested
  */
 #define _GNU_SOURCE
 #include <dlfcn.h>
 #include <errno.h>
+#include <fcntl.h>
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -57,6 +61,31 @@ ssize_t write(int fd, const void* data, size_t size) {
     }
     return real_write(fd, data, size);
 }
+
+static int refuse_tmpfile(int flags) {
+    const char* value = getenv("DQJ_FAULT_NO_TMPFILE");
+    return (flags & O_TMPFILE) == O_TMPFILE && value && strcmp(value, "1") == 0;
+}
+
+#define DQJ_OPEN_WRAPPER(name)                                                       \
+    int name(const char* path, int flags, ...) {                                     \
+        static int (*real)(const char*, int, ...);                                   \
+        if (!real) real = (int (*)(const char*, int, ...))dlsym(RTLD_NEXT, #name);   \
+        mode_t mode = 0;                                                             \
+        if (flags & (O_CREAT | O_TMPFILE)) {                                         \
+            va_list arguments;                                                       \
+            va_start(arguments, flags);                                              \
+            mode = va_arg(arguments, mode_t);                                        \
+            va_end(arguments);                                                       \
+        }                                                                            \
+        if (refuse_tmpfile(flags)) {                                                 \
+            errno = EOPNOTSUPP;                                                      \
+            return -1;                                                               \
+        }                                                                            \
+        return real(path, flags, mode);                                              \
+    }
+DQJ_OPEN_WRAPPER(open)
+DQJ_OPEN_WRAPPER(open64)
 
 int fsync(int fd) {
     static int (*real_fsync)(int);

@@ -442,6 +442,7 @@ const Writer kWriters[] = {
 
 class FaultInjection : public Hostile, public ::testing::WithParamInterface<Writer> {
 protected:
+    bool noTmpfile_ = false;  // the writer's fallback for file systems without O_TMPFILE
     dqj::test::CommandResult runWith(const std::string& mode, long long after) {
         std::string arguments = GetParam().arguments;
         const std::string out = (dir_ / "faulty").string(), ok = (dir_ / "ok").string();
@@ -449,6 +450,7 @@ protected:
         if (arguments.find("OK") != std::string::npos) arguments.replace(arguments.find("OK"), 2, ok);
         const std::string environment = "env LD_PRELOAD='" + std::string(DQJ_FAULT_SHIM) + "' DQJ_FAULT_DIR='" + out +
                                         "' DQJ_FAULT_MODE=" + mode + " DQJ_FAULT_AFTER=" + std::to_string(after) +
+                                        " DQJ_FAULT_NO_TMPFILE=" + (noTmpfile_ ? "1" : "0") +
                                         " ASAN_OPTIONS=verify_asan_link_order=0:detect_leaks=0 '" + DQJ_CLI + "' ";
         return dqj::test::runCommand("/bin/sh", "-c \"" + environment + arguments + " --force\"", dir_);
     }
@@ -481,8 +483,10 @@ TEST_P(FaultInjection, EveryFailureIsReportedAndLeavesTheOldFiles) {
                                     {"enospc", all / 2, "No space left on device"},  {"enospc", all - 1, "No space left on device"},
                                     {"short", all / 3, "No space left on device"},   {"short", all - 1, "No space left on device"},
                                     {"fsync", 0, "Input/output error"},             {"close", 0, "Input/output error"}};
+    for (const bool noTmpfile : {false, true})
     for (const Point& point : points) {
-        SCOPED_TRACE(point.mode + " after " + std::to_string(point.after) + " bytes");
+        noTmpfile_ = noTmpfile;
+        SCOPED_TRACE(point.mode + " after " + std::to_string(point.after) + " bytes" + (noTmpfile ? ", without O_TMPFILE" : ""));
         resetOld();
         const auto result = runWith(point.mode, point.after);
         EXPECT_EQ(result.exitCode, 1) << result.err;
@@ -501,11 +505,16 @@ TEST_P(FaultInjection, EveryFailureIsReportedAndLeavesTheOldFiles) {
             before += (long long)sizes[name];
         }
     }
-    // Short writes alone (no space problem) must still give complete files.
-    resetOld();
-    const auto shortOnly = runWith("short", 1LL << 40);
-    EXPECT_EQ(shortOnly.exitCode, 0) << shortOnly.err;
-    for (const char* name : GetParam().outputs) EXPECT_EQ(fs::file_size(faulty / name), sizes[name]) << name;
+    // Short writes alone (no space problem) must still give complete files, with and without
+    // O_TMPFILE, and leave no hidden file.
+    for (const bool noTmpfile : {false, true}) {
+        noTmpfile_ = noTmpfile;
+        resetOld();
+        const auto shortOnly = runWith("short", 1LL << 40);
+        EXPECT_EQ(shortOnly.exitCode, 0) << shortOnly.err;
+        for (const char* name : GetParam().outputs) EXPECT_EQ(fs::file_size(faulty / name), sizes[name]) << name;
+        EXPECT_FALSE(hasTemporary(filesIn(faulty)));
+    }
 }
 
 INSTANTIATE_TEST_SUITE_P(Writers, FaultInjection, ::testing::ValuesIn(kWriters),
