@@ -203,8 +203,10 @@ AtomicFile::AtomicFile(std::string path, Existing existing) : path_(std::move(pa
     existingMode(path_, existing);
     state.folder = folderOf(path_);
     removeStaleTemporaries(state.folder, hiddenPrefix(path_));
-    state.fd = ::open(state.folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0666);
-    if (state.fd < 0 && (errno == EOPNOTSUPP || errno == EISDIR || errno == EINVAL)) {
+    // An unnamed file is linked by its /proc/self/fd name; without /proc, use the fallback.
+    const bool unnamed = ::access("/proc/self/fd", X_OK) == 0;
+    state.fd = unnamed ? ::open(state.folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0666) : -1;
+    if (state.fd < 0 && (!unnamed || errno == EOPNOTSUPP || errno == EISDIR || errno == EINVAL)) {
         // No O_TMPFILE on this file system: a hidden, locked name (cleaned by the next run if we die).
         const std::string pattern = state.folder + "/" + hiddenPrefix(path_) + "XXXXXX";
         std::vector<char> name(pattern.begin(), pattern.end());
