@@ -333,7 +333,8 @@ TEST_F(Hostile, TheBakeMemoryGuardRespectsTheProcessLimit) {
     GTEST_SKIP() << "AddressSanitizer cannot run under a virtual memory limit";
 #else
     const auto start = std::chrono::steady_clock::now();
-    const std::string command = "ulimit -v 400000; '" + std::string(DQJ_CLI) + "' bake -q -r 4096 -o " + path("big.vdb") +
+    // An explicit --max-memory far above the cap: only the process limit can refuse it in time.
+    const std::string command = "ulimit -v 1200000; '" + std::string(DQJ_CLI) + "' bake -q -r 4096 --max-memory 100G -o " + path("big.vdb") +
                                 " 2> " + path("err.txt");
     const int status = std::system(command.c_str());
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
