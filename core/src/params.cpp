@@ -667,22 +667,29 @@ Params loadParams(const std::string& path, Validation validation) {
 void validate(const Params& params) {
     auto fail = [](const std::string& key, const std::string& message) { throw ParamError(key, key + ": " + message); };
     const Fractal& fractal = params.fractal;
+    // The ranges here are the parameter file's, so whatever passes (from flags or the C ABI)
+    // is written by --save-params as a file that reads back.
     for (int index = 0; index < 8; ++index)
-        if (!std::isfinite(component(fractal.c, index))) fail("fractal.c", "every component must be a finite number");
+        if (!(std::abs(component(fractal.c, index)) <= 100.0))
+            fail("fractal.c", "every component must be a finite number from -100 to 100");
     if (fractal.iterations < 1 || fractal.iterations > 100000) fail("fractal.iterations", "must be from 1 to 100000");
+    if (!(fractal.bailout > 1.0 && fractal.bailout <= 1e150))
+        fail("fractal.bailout", "must be a finite number greater than 1 and at most 1e150, got " + formatNumber(fractal.bailout));
     const double needed = minimumBailout(fractal);
-    if (!(fractal.bailout >= needed) || !std::isfinite(fractal.bailout))
+    if (!(fractal.bailout >= needed))
         fail("fractal.bailout", "is " + formatNumber(fractal.bailout) + " but must be at least the containment radius r_K = " +
                                     formatNumber(needed) + " of this constant and variant (points inside r_K may still be in the set)");
 
     const Slice slice = params.slice.effective();
     for (int axis = 0; axis < 3; ++axis)
         for (int index = 0; index < 8; ++index)
-            if (!std::isfinite(slice.axes[axis][index]) || !std::isfinite(slice.origin[index]))
-                fail("slice", "origin and axes must be finite numbers");
-    for (const PlaneRotation& rotation : params.slice.rotations)
+            if (!(std::abs(params.slice.base.axes[axis][index]) <= 1e9) || !(std::abs(params.slice.base.origin[index]) <= 1e9))
+                fail("slice", "origin and axes must be finite numbers from -1e9 to 1e9");
+    for (const PlaneRotation& rotation : params.slice.rotations) {
         if (rotation.first == rotation.second || rotation.first < 0 || rotation.first > 7 || rotation.second < 0 || rotation.second > 7)
             fail("slice.rotations", "a rotation plane must name two different axes");
+        if (!(std::abs(rotation.degrees) <= 36000.0)) fail("slice.rotations", "degrees must be finite numbers from -36000 to 36000");
+    }
     const Stretch stretch = stretchOf(slice);
     if (stretch.min < 1e-9 * std::max(1.0, stretch.max))
         fail("slice.axes", "the three axes are zero or parallel, so the slice is not 3-D; give three independent axes");
@@ -707,8 +714,8 @@ void validate(const Params& params) {
     // Camera vectors within the parameter file's range (+-1e9), so lengths and directions
     // computed from them stay finite and exact enough to aim a ray.
     auto sane3 = [&](const glm::dvec3& v) { return finite3(v) && std::abs(v.x) <= 1e9 && std::abs(v.y) <= 1e9 && std::abs(v.z) <= 1e9; };
-    if (params.bounds && (!finite3(params.bounds->center) || !std::isfinite(params.bounds->radius)))
-        fail("bounds", "center and radius must be finite numbers");
+    if (params.bounds && (!sane3(params.bounds->center) || !(params.bounds->radius <= 1e6)))
+        fail("bounds", "center must be 3 finite numbers from -1e9 to 1e9 and radius at most 1e6");
     const Camera& camera = params.camera;
     if (camera.position && !sane3(*camera.position)) fail("camera.position", "must be 3 finite numbers from -1e9 to 1e9");
     if (camera.target && !sane3(*camera.target)) fail("camera.target", "must be 3 finite numbers from -1e9 to 1e9");
@@ -743,9 +750,9 @@ void validate(const Params& params) {
         fail("render.width", "width and height must be from 1 to 16384");
     if (render.samples < 1 || render.samples > 16) fail("render.samples", "must be from 1 to 16");
     if (!(render.stepFactor > 0.0 && render.stepFactor <= 1.0)) fail("render.step_factor", "must be greater than 0 and at most 1");
-    if (!(render.maxStep > 0.0) || !std::isfinite(render.maxStep)) fail("render.max_step", "must be a finite number greater than 0");
-    if (render.maxSteps < 1) fail("render.max_steps", "must be at least 1");
-    if (!(render.detail > 0.0) || !std::isfinite(render.detail)) fail("render.detail", "must be a finite number greater than 0");
+    if (!(render.maxStep > 0.0 && render.maxStep <= 1e6)) fail("render.max_step", "must be greater than 0 and at most 1e6");
+    if (render.maxSteps < 1 || render.maxSteps > 1000000) fail("render.max_steps", "must be from 1 to 1000000");
+    if (!(render.detail > 0.0 && render.detail <= 1000.0)) fail("render.detail", "must be greater than 0 and at most 1000");
     if (render.normals == NormalMethod::Analytic && fractal.variant != Variant::Dual)
         fail("render.normals", "\"analytic\" normals come from the dual part of the true algebra and need variant \"dual\"; "
                                "use \"central\" or \"auto\" with variant \"" + std::string(variantName(fractal.variant)) + "\"");
@@ -761,9 +768,9 @@ void validate(const Params& params) {
     if (bake.resolution < 8 || bake.resolution > 16384) fail("bake.resolution", "must be a whole number from 8 to 16384");
     if (bake.bounds) {
         for (int axis = 0; axis < 3; ++axis)
-            if (!(bake.bounds->min[axis] < bake.bounds->max[axis]) || !std::isfinite(bake.bounds->min[axis]) ||
-                !std::isfinite(bake.bounds->max[axis]))
-                fail("bake.bounds", "min must be below max on every axis (x, y, z), with finite numbers");
+            if (!(bake.bounds->min[axis] < bake.bounds->max[axis]) || !(std::abs(bake.bounds->min[axis]) <= 1e6) ||
+                !(std::abs(bake.bounds->max[axis]) <= 1e6))
+                fail("bake.bounds", "min must be below max on every axis (x, y, z), with finite numbers from -1e6 to 1e6");
     }
     if (!(bake.bandWidth >= 1.0 && bake.bandWidth <= 32.0)) fail("bake.band_width", "must be from 1 to 32 voxels");
     if (bake.grids.empty()) fail("bake.grids", "must name at least one grid");

@@ -210,6 +210,17 @@ TEST_F(Hostile, ANonFiniteCameraIsRejectedAndNotSaved) {
     EXPECT_TRUE(filesIn(dir_).empty());
 }
 
+TEST_F(Hostile, WhatFlagsSetIsCheckedWithTheFileFormatsRanges) {
+    // A flag may not set what --save-params would write as a file that does not read back.
+    for (const std::string flags : {"--bailout 1e200", "--c 1000 0 0 0 0 0 0 0", "--detail 5000", "--max-steps 2000000",
+                                    "--rotate a.j,b.s:1e9", "--camera-position 1e10 0 0"}) {
+        const auto result = run("render -q -W 8 -H 8 " + flags + " -o " + path("out.png") + " --save-params " + path("p.json"));
+        EXPECT_EQ(result.exitCode, 2) << flags << ": " << result.err;
+        EXPECT_CONTAINS(result.err, "must be");
+        EXPECT_TRUE(filesIn(dir_).empty()) << flags;
+    }
+}
+
 // --- Outputs: empty names, one file twice, no-clobber, non-regular files -----------------
 
 TEST_F(Hostile, AnEmptyOutputNameIsRejected) {
