@@ -47,6 +47,7 @@ int runBake(const BakeFlags& flags) {
         options.dense = flags.dense;
         options.memoryLimit = memoryLimit;
         options.monitor = &monitor;
+        options.existing = existingPolicy(flags.force);
         const std::string label = jobs.size() > 1 ? "baking frame " + std::to_string(job.frame) : "baking";
         BakeStats stats;
         {

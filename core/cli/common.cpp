@@ -43,6 +43,7 @@ void installInterruptHandlers() {
     sigemptyset(&action.sa_mask);
     sigaction(SIGINT, &action, nullptr);
     sigaction(SIGTERM, &action, nullptr);
+    sigaction(SIGHUP, &action, nullptr);  // a closed terminal or a dropped SSH session: stop cleanly as for SIGTERM
 }
 
 bool interrupted() { return interruptRequested.load(); }
@@ -114,8 +115,12 @@ void checkOutputPath(const std::string& path, bool force, const std::string& fla
     namespace fs = std::filesystem;
     std::error_code error;
     const fs::path target(path);
+    if (path.empty()) throw ParamError("output.path", flag + " is empty; give a file name");
     if (fs::is_directory(target, error))
         throw ParamError("output.path", flag + " '" + path + "' is a folder; give a file name");
+    if (fs::exists(target, error) && !fs::is_regular_file(target, error))
+        throw ParamError("output.path", flag + " '" + path + "' is not a regular file (a device, FIFO or socket); "
+                                        "dqjulia writes only regular files");
     if (fs::exists(target, error) && !force)
         throw ParamError("output.path", flag + " '" + path + "' exists; pass --force to overwrite it");
     const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
@@ -123,18 +128,49 @@ void checkOutputPath(const std::string& path, bool force, const std::string& fla
         throw ParamError("output.path", flag + " '" + path + "': the folder '" + folder.string() + "' does not exist");
     if (::access(folder.c_str(), W_OK) != 0)
         throw ParamError("output.path", flag + " '" + path + "': the folder '" + folder.string() + "' is not writable");
+    try {
+        checkWritable(path);  // not a device or FIFO, and a file can really be created there
+    } catch (const std::runtime_error& failure) {
+        throw ParamError("output.path", flag + ": " + failure.what());
+    }
+}
+
+void checkDistinctOutputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
+    namespace fs = std::filesystem;
+    std::vector<fs::path> resolved;
+    for (const auto& [flag, path] : outputs) {
+        std::error_code error;
+        fs::path canonical = fs::weakly_canonical(fs::absolute(path, error), error);
+        resolved.push_back(error ? fs::path(path).lexically_normal() : canonical);
+    }
+    for (std::size_t a = 0; a < outputs.size(); ++a)
+        for (std::size_t b = 0; b < a; ++b)
+            if (resolved[a] == resolved[b])
+                throw ParamError("output.path", outputs[b].first + " and " + outputs[a].first + " both name '" +
+                                                    outputs[a].second + "'; give them different files");
 }
 
 int reportErrors(const std::string& command, const std::function<int()>& body) {
     try {
         return body();
-    } catch (const ParamError& error) {
-        std::cerr << "dqjulia " << command << ": " << error.what() << "\n";
-        return kBadInput;
     } catch (const Cancelled&) {
         std::cerr << "dqjulia " << command << ": interrupted; nothing was written\n";
         return kInterrupted;
     } catch (const std::exception& error) {
+        if (interrupted()) {  // e.g. a read of the parameter file cut short by Ctrl-C: not bad input
+            std::cerr << "dqjulia " << command << ": interrupted; nothing was written\n";
+            return kInterrupted;
+        }
+        if (const auto* param = dynamic_cast<const ParamError*>(&error)) {
+            std::cerr << "dqjulia " << command << ": " << param->what() << "\n";
+            return kBadInput;
+        }
+        if (dynamic_cast<const std::bad_alloc*>(&error)) {
+            std::cerr << "dqjulia " << command
+                      << ": out of memory: the work needs more memory than this process may use (see ulimit -v and the "
+                         "container's memory limit); try a smaller resolution or size\n";
+            return kFailure;
+        }
         std::cerr << "dqjulia " << command << ": " << error.what() << "\n";
         return kFailure;
     }

@@ -34,15 +34,24 @@ struct FractalOptions {
     void applyTo(Params& params) const;
 };
 
-/// Checks an output path before any long work starts: refuses an existing file unless `force`,
-/// and a folder that is missing or not writable. Throws ParamError naming `flag`.
+/// Checks an output path before any long work starts: refuses an empty name, an existing file
+/// unless `force`, a folder, device or FIFO, and a folder that is missing or where no file can
+/// be created (tried). Throws ParamError naming `flag`.
 void checkOutputPath(const std::string& path, bool force, const std::string& flag = "--output");
+
+/// Refuses two outputs of one run that name the same file (one would silently replace the
+/// other): `outputs` holds (flag, path) pairs. Throws ParamError naming both flags.
+void checkDistinctOutputs(const std::vector<std::pair<std::string, std::string>>& outputs);
+
+/// What writers do with a file that exists when they publish: without --force it is kept (and
+/// the write fails), even if it appeared while the work ran.
+inline Existing existingPolicy(bool force) { return force ? Existing::Replace : Existing::Keep; }
 
 /// Runs `body`, printing "dqjulia: <message>" for errors and returning the exit code.
 int reportErrors(const std::string& command, const std::function<int()>& body);
 
 /// A progress bar with ETA on stderr when it is a terminal (and not quiet); silent otherwise.
-/// Returns false once SIGINT or SIGTERM arrived, which cancels the work.
+/// Returns false once SIGINT, SIGTERM or SIGHUP arrived, which cancels the work.
 class ProgressBar {
 public:
     ProgressBar(std::string label, bool quiet);
@@ -62,7 +71,7 @@ private:
     bool drawn_ = false;
 };
 
-/// Installs SIGINT/SIGTERM handlers that ask running work to stop (see interrupted()).
+/// Installs SIGINT/SIGTERM/SIGHUP handlers that ask running work to stop (see interrupted()).
 void installInterruptHandlers();
 bool interrupted();
 

@@ -65,7 +65,7 @@ int runExplore(const ExploreCommandOptions& options) {
     progress.finish();
     SheetLayout layout;
     layout.columns = options.columns;
-    writeImage(composeSheet(tiles, layout), sheetPath.string(), ImageFormat::Png8);
+    writeImage(composeSheet(tiles, layout), sheetPath.string(), ImageFormat::Png8, existingPolicy(options.force));
     if (!options.quiet)
         std::cerr << "wrote " << sheetPath.string() << " and " << tiles.size() << " tiles (tile_NN.png, tile_NN.json) to "
                   << folder.string() << "; " << found.skippedEmpty << " of " << found.attempts

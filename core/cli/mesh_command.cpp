@@ -59,7 +59,7 @@ int runMesh(const BakeFlags& flags) {
             std::cerr << "dqjulia mesh: interrupted; " << paths[index] << " was not written\n";
             return kInterrupted;
         }
-        writeMesh(mesh, paths[index]);
+        writeMesh(mesh, paths[index], existingPolicy(flags.force));
         if (mesh.positions.empty()) {
             const std::string reason = inspect(perFrame[index]).emptyReason;
             std::cerr << "dqjulia mesh: warning: " << paths[index] << " is empty: "

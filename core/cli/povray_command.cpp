@@ -50,9 +50,15 @@ int runPovray(const PovrayOptions& options) {
     write.df3Resolution = options.df3Resolution;
     write.df3Bits = options.df3Bits;
     write.sourceName = options.fractal.paramsFile;
+    write.existing = existingPolicy(options.force);
     // Check every output before the work: existing files need --force. An identical copy of
     // the include is fine (several scenes share one folder); a different one is not replaced silently.
     const PovrayFiles files = povrayFiles(params, options.output, write);
+    std::vector<std::pair<std::string, std::string>> outputs;
+    for (const auto& [flag, path] : {std::pair<std::string, std::string>{"--output", files.scene}, {"--df3 (grid)", files.df3},
+                                     {"--df3 (scene)", files.df3Scene}, {"the include copy", files.include}})
+        if (!path.empty()) outputs.emplace_back(flag, path);
+    checkDistinctOutputs(outputs);
     if (!files.scene.empty()) checkOutputPath(files.scene, options.force);
     if (!files.df3.empty()) checkOutputPath(files.df3, options.force, "--df3");
     if (!files.df3Scene.empty()) checkOutputPath(files.df3Scene, options.force, "--df3");

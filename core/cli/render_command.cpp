@@ -15,13 +15,14 @@ namespace {
 
 struct RenderOptions {
     FractalOptions fractal;
-    std::string output;
+    std::optional<std::string> output;  // given empty (-o '') is an error, not the default
     std::string format;
     std::optional<int> width, height, samples, maxSteps;
     std::optional<double> stepFactor, maxStep, detail, fov;
     std::string normals, coloring;
     std::vector<double> cameraPosition, cameraTarget;
     std::string saveParams;
+    bool saveParamsGiven = false;
     std::string voxels;
     bool quiet = false;
     bool stats = false;
@@ -31,7 +32,10 @@ struct RenderOptions {
 Params loadRenderParams(const RenderOptions& options) {
     Params params = options.fractal.paramsFile.empty() ? Params{} : loadParams(options.fractal.paramsFile, Validation::TypesOnly);
     options.fractal.applyTo(params);
-    if (!options.output.empty()) params.output.path = options.output;
+    if (options.output) {
+        if (options.output->empty()) throw ParamError("output.path", "--output is empty; give a file name");
+        params.output.path = *options.output;
+    }
     if (!options.format.empty()) {
         params.output.format = options.format == "png16" ? ImageFormat::Png16
                                : options.format == "exr" ? ImageFormat::Exr
@@ -65,9 +69,10 @@ Params loadRenderParams(const RenderOptions& options) {
 int runRender(const RenderOptions& options) {
     const Params params = loadRenderParams(options);
     checkOutputPath(params.output.path, options.force);
-    if (!options.saveParams.empty()) {
+    if (options.saveParamsGiven) {
         checkOutputPath(options.saveParams, options.force, "--save-params");
-        saveParams(params, options.saveParams);
+        checkDistinctOutputs({{"--output", params.output.path}, {"--save-params", options.saveParams}});
+        saveParams(params, options.saveParams, existingPolicy(options.force));
     }
     // Say up front when the slice is provably empty: an empty picture needs a reason.
     const std::string provenEmpty = provenEmptyReason(params);
@@ -77,7 +82,8 @@ int runRender(const RenderOptions& options) {
     const RenderResult result = options.voxels.empty() ? render(params, progress.callback())
                                                        : renderVoxels(params, options.voxels, progress.callback());
     progress.finish();
-    writeImage(result.image, params.output.path, formatFor(params.output));
+    if (interrupted()) throw Cancelled();  // a signal in the last moments of the work: write nothing
+    writeImage(result.image, params.output.path, formatFor(params.output), existingPolicy(options.force));
 
     const RenderStats& stats = result.stats;
     if (stats.hitPixels == 0) {
@@ -128,7 +134,10 @@ Runner addRenderCommand(CLI::App& app) {
     command->add_flag("-f,--force", options->force, "Overwrite existing output files");
     command->add_flag("-q,--quiet", options->quiet, "No progress bar or summary");
     command->add_flag("--stats", options->stats, "Print ray and step counts to stdout");
-    return [options] { return reportErrors("render", [&] { return runRender(*options); }); };
+    return [options, command] {
+        options->saveParamsGiven = command->count("--save-params") != 0;
+        return reportErrors("render", [&] { return runRender(*options); });
+    };
 }
 
 }  // namespace dqj::cli

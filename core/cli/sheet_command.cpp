@@ -28,7 +28,7 @@ int runSheet(const SheetOptions& options) {
     SheetLayout layout;
     layout.columns = options.columns;
     layout.labelLines = options.labelLines;
-    writeImage(composeSheet(tiles, layout), options.output, ImageFormat::Png8);
+    writeImage(composeSheet(tiles, layout), options.output, ImageFormat::Png8, existingPolicy(options.force));
     return kSuccess;
 }
 

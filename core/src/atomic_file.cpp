@@ -1,24 +1,32 @@
-// Temporary file + rename (see atomic_file.hpp). POSIX only: mkstemp, fsync, rename.
+// The checked atomic writer (see atomic_file.hpp). Linux: O_TMPFILE, linkat through
+// /proc/self/fd, renameat2(RENAME_NOREPLACE), flock; POSIX fallbacks where they are missing.
 #include "atomic_file.hpp"
 
 #include <cctype>
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <stdexcept>
+#include <streambuf>
 #include <vector>
 
+#include <dirent.h>
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 namespace dqj {
 namespace {
 
-std::runtime_error systemError(const std::string& path, int error) {
-    return std::runtime_error(AtomicFile::failureMessage(path, std::strerror(error)));
+std::runtime_error failure(const std::string& path, const std::string& reason) {
+    return std::runtime_error(AtomicFile::failureMessage(path, reason));
 }
+std::runtime_error systemError(const std::string& path, int error) { return failure(path, std::strerror(error)); }
 
 /// The process umask, read without changing it: umask() can only be read by setting it,
 /// which would race with other threads creating files. Linux reports it in /proc.
@@ -31,51 +39,261 @@ mode_t currentUmask() {
     return 022;
 }
 
-}  // namespace
+/// A buffered, seekable stream buffer over a file descriptor that checks every write (short
+/// writes are continued, EINTR retried) and keeps the first error's errno.
+class CheckedBuffer : public std::streambuf {
+public:
+    explicit CheckedBuffer(int fd) : fd_(fd), buffer_(1 << 16) { setp(buffer_.data(), buffer_.data() + buffer_.size()); }
+    int error() const { return error_; }
+    /// Writes out what is buffered; false (and error()) on failure.
+    bool drain() {
+        const char* data = pbase();
+        std::size_t size = std::size_t(pptr() - pbase());
+        setp(buffer_.data(), buffer_.data() + buffer_.size());
+        return writeAll(data, size);
+    }
 
-std::string AtomicFile::failureMessage(const std::string& path, const std::string& reason) {
-    return "cannot write '" + path + "': " + reason;
+protected:
+    int_type overflow(int_type ch) override {
+        if (!drain()) return traits_type::eof();
+        if (!traits_type::eq_int_type(ch, traits_type::eof())) {
+            *pptr() = traits_type::to_char_type(ch);
+            pbump(1);
+        }
+        return traits_type::not_eof(ch);
+    }
+    std::streamsize xsputn(const char* data, std::streamsize count) override {
+        if (count <= epptr() - pptr()) {
+            std::memcpy(pptr(), data, std::size_t(count));
+            pbump(int(count));
+            return count;
+        }
+        if (!drain() || !writeAll(data, std::size_t(count))) return 0;
+        return count;
+    }
+    int sync() override { return drain() ? 0 : -1; }
+    pos_type seekoff(off_type offset, std::ios_base::seekdir direction, std::ios_base::openmode) override {
+        if (!drain()) return pos_type(off_type(-1));
+        const int whence = direction == std::ios_base::beg ? SEEK_SET : direction == std::ios_base::cur ? SEEK_CUR : SEEK_END;
+        const off_t position = ::lseek(fd_, off_t(offset), whence);
+        if (position < 0) {
+            if (!error_) error_ = errno;
+            return pos_type(off_type(-1));
+        }
+        return pos_type(off_type(position));
+    }
+    pos_type seekpos(pos_type position, std::ios_base::openmode mode) override {
+        return seekoff(off_type(position), std::ios_base::beg, mode);
+    }
+
+private:
+    bool writeAll(const char* data, std::size_t size) {
+        if (error_) return false;
+        while (size > 0) {
+            const ssize_t written = ::write(fd_, data, size);
+            if (written < 0 && errno == EINTR) continue;
+            if (written <= 0) {
+                error_ = written < 0 ? errno : EIO;
+                return false;
+            }
+            data += written;
+            size -= std::size_t(written);
+        }
+        return true;
+    }
+
+    int fd_;
+    std::vector<char> buffer_;
+    int error_ = 0;
+};
+
+std::string folderOf(const std::string& path) {
+    const std::filesystem::path folder = std::filesystem::path(path).parent_path();
+    return folder.empty() ? "." : folder.string();
 }
 
-AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
-    const std::filesystem::path target(path_);
-    if (path_.empty() || !target.has_filename()) throw std::runtime_error(failureMessage(path_, "not a file name"));
-    const std::filesystem::path folder = target.parent_path();
-    std::string hidden = ".";  // appended, not operator+: GCC 12 warns falsely (-Wrestrict) on the latter
-    hidden += target.filename().string();
-    hidden += ".tmp-XXXXXX";
-    const std::string pattern = (folder / hidden).string();
-    std::vector<char> name(pattern.begin(), pattern.end());
-    name.push_back('\0');
-    const int fd = ::mkstemp(name.data());
-    if (fd < 0) throw systemError(path_, errno);
-    ::close(fd);
-    tempPath_ = name.data();
+std::string hiddenPrefix(const std::string& path) {
+    std::string prefix = ".";  // appended, not operator+: GCC 12 warns falsely (-Wrestrict) on the latter
+    prefix += std::filesystem::path(path).filename().string();
+    prefix += ".tmp-";
+    return prefix;
+}
+
+/// Removes ".name.tmp-*" files in the folder that no live writer holds locked: what a writer
+/// killed between creating and publishing its hidden file left behind. Files changed in the last
+/// few seconds are left alone: a writer locks its file just after creating it.
+void removeStaleTemporaries(const std::string& folder, const std::string& prefix) {
+    DIR* directory = ::opendir(folder.c_str());
+    if (!directory) return;
+    while (const dirent* entry = ::readdir(directory)) {
+        const std::string name = entry->d_name;
+        if (name.rfind(prefix, 0) != 0 || name.size() != prefix.size() + 6) continue;
+        const std::string stale = folder + "/" + name;
+        const int fd = ::open(stale.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
+        if (fd < 0) continue;
+        struct stat info {};
+        if (::fstat(fd, &info) == 0 && S_ISREG(info.st_mode) && info.st_mtime + 5 < std::time(nullptr) &&
+            ::flock(fd, LOCK_EX | LOCK_NB) == 0)
+            ::unlink(stale.c_str());
+        ::close(fd);
+    }
+    ::closedir(directory);
+}
+
+std::string randomSuffix() {
+    static thread_local std::mt19937_64 generator{std::random_device{}() ^ (std::uint64_t(::getpid()) << 32)};
+    static constexpr char kLetters[] = "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789";
+    std::string suffix(6, 'x');
+    for (char& ch : suffix) ch = kLetters[generator() % (sizeof kLetters - 1)];
+    return suffix;
+}
+
+/// Checks what is at `path` now: nothing or a regular file (through symbolic links), and not
+/// present at all when `existing` is Keep. Returns the mode of an existing file, or -1.
+int existingMode(const std::string& path, Existing existing) {
+    struct stat info {};
+    if (::stat(path.c_str(), &info) != 0) {
+        if (errno == ENOENT) return -1;
+        throw systemError(path, errno);
+    }
+    if (S_ISDIR(info.st_mode)) throw failure(path, "it is a folder; give a file name");
+    if (!S_ISREG(info.st_mode))
+        throw failure(path, "it is not a regular file (a device, FIFO or socket); dqjulia writes only regular files");
+    if (existing == Existing::Keep) throw failure(path, "the file exists and is kept (pass --force to overwrite it)");
+    return int(info.st_mode & 07777);
+}
+
+}  // namespace
+
+struct AtomicFile::State {
+    Existing existing = Existing::Replace;
+    std::string folder;
+    int fd = -1;
+    std::string tempPath;  // "" with O_TMPFILE: the data has no name until commit()
+    bool committed = false;
+    std::unique_ptr<CheckedBuffer> buffer;
+    std::unique_ptr<std::ostream> stream;
+};
+
+std::string printableText(const std::string& text) {
+    std::string result;
+    result.reserve(text.size());
+    for (const char ch : text) {
+        const auto byte = static_cast<unsigned char>(ch);
+        if ((byte < 0x20 && ch != '\n' && ch != '\t') || byte == 0x7f) {
+            char escaped[8];
+            std::snprintf(escaped, sizeof escaped, "\\x%02x", byte);
+            result += escaped;
+        } else {
+            result += ch;
+        }
+    }
+    return result;
+}
+
+std::string AtomicFile::failureMessage(const std::string& path, const std::string& reason) {
+    return printableText("cannot write '" + path + "': " + reason);
+}
+
+AtomicFile::AtomicFile(std::string path, Existing existing) : path_(std::move(path)), state_(std::make_unique<State>()) {
+    State& state = *state_;
+    state.existing = existing;
+    if (path_.empty() || !std::filesystem::path(path_).has_filename()) throw failure(path_, "not a file name");
+    if (path_.find('\0') != std::string::npos) throw failure(path_, "the name holds a NUL byte");
+    existingMode(path_, existing);
+    state.folder = folderOf(path_);
+    removeStaleTemporaries(state.folder, hiddenPrefix(path_));
+    // An unnamed file is linked by its /proc/self/fd name; without /proc, use the fallback.
+    const bool unnamed = ::access("/proc/self/fd", X_OK) == 0;
+    state.fd = unnamed ? ::open(state.folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0666) : -1;
+    if (state.fd < 0 && (!unnamed || errno == EOPNOTSUPP || errno == EISDIR || errno == EINVAL)) {
+        // No O_TMPFILE on this file system: a hidden, locked name (cleaned by the next run if we die).
+        const std::string pattern = state.folder + "/" + hiddenPrefix(path_) + "XXXXXX";
+        std::vector<char> name(pattern.begin(), pattern.end());
+        name.push_back('\0');
+        state.fd = ::mkostemp(name.data(), O_CLOEXEC);
+        if (state.fd >= 0) state.tempPath = name.data();
+    }
+    if (state.fd < 0) throw systemError(path_, errno);
+    ::flock(state.fd, LOCK_EX | LOCK_NB);
+    state.buffer = std::make_unique<CheckedBuffer>(state.fd);
+    state.stream = std::make_unique<std::ostream>(state.buffer.get());
 }
 
 AtomicFile::~AtomicFile() {
-    if (!committed_) ::unlink(tempPath_.c_str());
+    if (state_->fd >= 0) ::close(state_->fd);
+    if (!state_->committed && !state_->tempPath.empty()) ::unlink(state_->tempPath.c_str());
 }
 
+std::ostream& AtomicFile::stream() { return *state_->stream; }
+
 void AtomicFile::commit() {
-    if (committed_) return;
-    const int fd = ::open(tempPath_.c_str(), O_RDONLY | O_CLOEXEC);
-    if (fd < 0) throw systemError(path_, errno);
-    // mkstemp makes the file 0600; a user's output should be as readable as any other file.
-    // If the file is replaced, keep the existing file's mode instead.
-    struct stat existing {};
-    const mode_t mode = ::stat(path_.c_str(), &existing) == 0 ? (existing.st_mode & 07777) : (0666 & ~currentUmask());
-    if (::fchmod(fd, mode) != 0 || ::fsync(fd) != 0) {
+    State& state = *state_;
+    if (state.committed) return;
+    state.stream->flush();
+    if (!state.buffer->drain() || state.buffer->error() || !*state.stream)
+        throw systemError(path_, state.buffer->error() ? state.buffer->error() : EIO);
+    // Keep the mode of a file being replaced; a new file gets 0666 minus the umask, as open()
+    // would give it (O_TMPFILE already applied the umask, mkstemp did not).
+    // (With Keep, a file that appeared meanwhile is found by the no-replace publishing below.)
+    const int oldMode = state.existing == Existing::Keep ? -1 : existingMode(path_, Existing::Replace);
+    const mode_t mode = oldMode >= 0 ? mode_t(oldMode) : (0666 & ~currentUmask());
+    if (::fchmod(state.fd, mode) != 0 || ::fsync(state.fd) != 0) throw systemError(path_, errno);
+
+    // Close the data descriptor (checked: some file systems report write errors only here),
+    // keeping an O_PATH reference so an unnamed file can still be linked.
+    int pathFd = -1;
+    if (state.tempPath.empty()) {
+        pathFd = ::open(("/proc/self/fd/" + std::to_string(state.fd)).c_str(), O_PATH | O_CLOEXEC);
+        if (pathFd < 0) throw systemError(path_, errno);
+    }
+    const int fd = state.fd;
+    state.fd = -1;
+    if (::close(fd) != 0) {
         const int error = errno;
-        ::close(fd);
+        if (pathFd >= 0) ::close(pathFd);
         throw systemError(path_, error);
     }
-    ::close(fd);
-    if (::rename(tempPath_.c_str(), path_.c_str()) != 0) throw systemError(path_, errno);
-    committed_ = true;
-    // Make the rename itself durable; best effort, since the data is already in place.
-    const std::filesystem::path folder = std::filesystem::path(path_).parent_path();
-    const int folderFd = ::open(folder.empty() ? "." : folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+
+    int error = 0;
+    if (pathFd >= 0) {
+        const std::string source = "/proc/self/fd/" + std::to_string(pathFd);
+        if (state.existing == Existing::Keep) {
+            if (::linkat(AT_FDCWD, source.c_str(), AT_FDCWD, path_.c_str(), AT_SYMLINK_FOLLOW) != 0) error = errno;
+        } else {
+            // linkat cannot replace: link under a hidden name, then rename over the target.
+            std::string hidden;
+            for (int attempt = 0; attempt < 100; ++attempt) {
+                hidden = state.folder + "/" + hiddenPrefix(path_) + randomSuffix();
+                if (::linkat(AT_FDCWD, source.c_str(), AT_FDCWD, hidden.c_str(), AT_SYMLINK_FOLLOW) == 0) {
+                    error = 0;
+                    break;
+                }
+                error = errno;
+                if (error != EEXIST) break;
+            }
+            if (!error && ::rename(hidden.c_str(), path_.c_str()) != 0) {
+                error = errno;
+                ::unlink(hidden.c_str());
+            }
+        }
+        ::close(pathFd);
+    } else if (state.existing == Existing::Keep) {
+        if (::renameat2(AT_FDCWD, state.tempPath.c_str(), AT_FDCWD, path_.c_str(), RENAME_NOREPLACE) != 0) {
+            error = errno;
+            if (error == EINVAL || error == ENOSYS) {  // no RENAME_NOREPLACE here: link fails on an existing name too
+                error = ::link(state.tempPath.c_str(), path_.c_str()) == 0 ? 0 : errno;
+                if (!error) ::unlink(state.tempPath.c_str());
+            }
+        }
+    } else if (::rename(state.tempPath.c_str(), path_.c_str()) != 0) {
+        error = errno;
+    }
+    if (error == EEXIST) throw failure(path_, "the file appeared while dqjulia worked and is kept (pass --force to overwrite it)");
+    if (error) throw systemError(path_, error);
+    state.committed = true;
+    // Make the new name durable; best effort, since the data is already in place.
+    const int folderFd = ::open(state.folder.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
     if (folderFd >= 0) {
         ::fsync(folderFd);
         ::close(folderFd);
@@ -86,6 +304,10 @@ std::string AtomicFile::lowercaseExtension(const std::string& path) {
     std::string extension = std::filesystem::path(path).extension().string();
     for (char& ch : extension) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
     return extension;
+}
+
+void checkWritable(const std::string& path, Existing existing) {
+    AtomicFile probe(path, existing);  // creates (and on destruction discards) a real temporary file there
 }
 
 }  // namespace dqj

@@ -1,22 +1,36 @@
-// atomic_file.hpp - write a file under a temporary name in its folder, then rename it into place.
+// atomic_file.hpp - the one checked, atomic file writer every format uses.
 //
-// Internal to libdqjulia (not exported). Every writer (images, and later VDB grids and meshes)
-// writes to tempPath() and calls commit(): a failure or an exception before commit() never
-// leaves a partial file and never destroys an existing file at the final path, because rename()
-// within one folder is atomic.
+// Internal to libdqjulia (not exported). A writer puts its bytes into stream() and calls
+// commit(). Until commit() the data lives in an unnamed file in the target's folder
+// (O_TMPFILE), so a crash, SIGKILL or power loss leaves nothing behind; where the file
+// system has no O_TMPFILE, a hidden ".name.tmp-XXXXXX" is used instead, locked while it is
+// written, and removed by the next writer into that folder if its writer died. Every write,
+// the final flush, fsync and close are checked before the file is published under its name,
+// so a full disk or a failing device is an error ("No space left on device"), never a
+// truncated file. commit() either replaces an existing file (Existing::Replace) or refuses to
+// (Existing::Keep, atomically: a file created meanwhile by someone else is never replaced).
 #pragma once
 
+#include <memory>
+#include <ostream>
 #include <string>
+
+#include "dqjulia/params.hpp"  // Existing
 
 namespace dqj {
 
+/// `text` with NUL and the other control characters except newline and tab written as \xNN,
+/// so a message printed through a C string is never cut short and cannot drive a terminal.
+std::string printableText(const std::string& text);
+
 class AtomicFile {
 public:
-    /// Creates an empty, uniquely named temporary file next to `path` (".name.tmp-XXXXXX").
-    /// Throws std::runtime_error ("cannot write 'path': reason") if the folder is missing or
-    /// not writable.
-    explicit AtomicFile(std::string path);
-    /// Removes the temporary file unless commit() succeeded.
+    /// Opens the temporary file in the folder of `path`. Throws std::runtime_error ("cannot
+    /// write 'path': reason") if the folder is missing or not writable, if `path` is a folder
+    /// or another non-regular file (a device, FIFO or socket), or if it exists and `existing`
+    /// is Keep.
+    explicit AtomicFile(std::string path, Existing existing = Existing::Replace);
+    /// Discards the data unless commit() succeeded.
     ~AtomicFile();
 
     AtomicFile(const AtomicFile&) = delete;
@@ -24,13 +38,14 @@ public:
 
     /// The final path given to the constructor.
     const std::string& path() const { return path_; }
-    /// Where the writer puts the data. The file exists (empty) and no descriptor is held open,
-    /// so a writer may open it by name (libpng, OpenEXR, OpenVDB all do).
-    const std::string& tempPath() const { return tempPath_; }
+    /// Where the writer puts the data: buffered, seekable, every write checked (the first
+    /// failure is kept and reported by commit()).
+    std::ostream& stream();
 
-    /// Flushes the temporary file to disk, gives it the usual permissions (0666 minus the
-    /// umask, as a plain open() would) and renames it to the final path. Throws
-    /// std::runtime_error with the path and the reason on failure.
+    /// Checks every write, flushes, fsyncs and closes the file, gives it the usual
+    /// permissions (0666 minus the umask, or those of the file it replaces) and publishes it
+    /// under path(). Throws std::runtime_error with the path and the reason on failure; the
+    /// previous file at path() is then untouched.
     void commit();
 
     /// "cannot write 'path': reason" - the message writers use for their own failures too.
@@ -38,10 +53,11 @@ public:
     /// The extension of a path's file name in lower case, with its dot (".vdb"), or "".
     static std::string lowercaseExtension(const std::string& path);
 
+    struct State;
+
 private:
     std::string path_;
-    std::string tempPath_;
-    bool committed_ = false;
+    std::unique_ptr<State> state_;
 };
 
 }  // namespace dqj

@@ -9,9 +9,11 @@
 #include <fstream>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <openvdb/io/File.h>
@@ -38,6 +40,16 @@ public:
 
 private:
     const std::atomic<bool>& stop_;
+};
+
+/// OpenVDB's file writer, aimed at AtomicFile's checked stream. io::File::write opens its own
+/// std::ofstream and never checks it (a full disk gave a truncated file and no error);
+/// Archive's seekable stream writer is what io::File::write calls, so the bytes are the same.
+class CheckedVdbWriter : public openvdb::io::Archive {
+public:
+    void write(std::ostream& out, const openvdb::GridPtrVec& grids, const openvdb::MetaMap& metadata) const {
+        openvdb::io::Archive::write(out, grids, /*seekable=*/true, metadata);
+    }
 };
 
 /// Memory per sampled 8^3 leaf beyond the sampled leaf itself: the rebuild's mesh and distance
@@ -149,17 +161,78 @@ openvdb::FloatGrid::Ptr bakeLevelSet(const Params& params, const BakeOptions& op
 MemoryLimitError::MemoryLimitError(const std::string& message, std::uint64_t estimate, std::uint64_t limit)
     : ParamError("bake.resolution", "bake.resolution: " + message), estimate_(estimate), limit_(limit) {}
 
+namespace {
+
+/// A number from a one-line file ("max" and unreadable files: nullopt).
+std::optional<std::uint64_t> readNumberFile(const std::string& path) {
+    std::ifstream file(path);
+    std::uint64_t value = 0;
+    if (!(file >> value)) return std::nullopt;
+    return value;
+}
+
+/// "VmSize:  123 kB" from /proc/self/status, in bytes.
+std::uint64_t statusBytes(const std::string& key) {
+    std::ifstream status("/proc/self/status");
+    std::string line;
+    while (std::getline(status, line))
+        if (line.rfind(key, 0) == 0) return std::strtoull(line.c_str() + key.size(), nullptr, 10) * 1024;
+    return 0;
+}
+
+std::uint64_t headroom(std::uint64_t limit, std::uint64_t used) { return limit > used ? limit - used : 0; }
+
+}  // namespace
+
+std::uint64_t processMemoryHeadroom() {
+    std::uint64_t result = UINT64_MAX;
+    struct rlimit limit {};
+    if (::getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+        result = std::min(result, headroom(limit.rlim_cur, statusBytes("VmSize:")));
+    if (::getrlimit(RLIMIT_DATA, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
+        result = std::min(result, headroom(limit.rlim_cur, statusBytes("VmData:")));
+    // Every cgroup from ours up to the root may cap us ("0::/a/b" for v2, "N:memory:/a/b" for v1).
+    std::ifstream cgroups("/proc/self/cgroup");
+    std::string line;
+    while (std::getline(cgroups, line)) {
+        const std::size_t first = line.find(':'), second = line.find(':', first + 1);
+        if (first == std::string::npos || second == std::string::npos) continue;
+        const std::string controllers = line.substr(first + 1, second - first - 1);
+        std::string group = line.substr(second + 1);
+        const bool v2 = controllers.empty();
+        if (!v2 && controllers.find("memory") == std::string::npos) continue;
+        const std::string root = v2 ? "/sys/fs/cgroup" : "/sys/fs/cgroup/memory";
+        for (;;) {
+            const std::string folder = root + (group == "/" ? "" : group);
+            const auto max = readNumberFile(folder + (v2 ? "/memory.max" : "/memory.limit_in_bytes"));
+            const auto used = readNumberFile(folder + (v2 ? "/memory.current" : "/memory.usage_in_bytes"));
+            if (max && *max < (std::uint64_t(1) << 60)) result = std::min(result, headroom(*max, used.value_or(0)));
+            if (group.empty() || group == "/") break;
+            const std::size_t slash = group.rfind('/');
+            group = slash == 0 || slash == std::string::npos ? "/" : group.substr(0, slash);
+        }
+    }
+    return result;
+}
+
 std::uint64_t defaultMemoryLimit() {
     std::ifstream meminfo("/proc/meminfo");
     std::string key;
     std::uint64_t kilobytes = 0;
     std::string unit;
+    std::uint64_t half = 0;
     while (meminfo >> key >> kilobytes >> unit) {
-        if (key == "MemAvailable:") return kilobytes * 1024 / 2;
+        if (key == "MemAvailable:") {
+            half = kilobytes * 1024 / 2;
+            break;
+        }
     }
-    const long pages = ::sysconf(_SC_AVPHYS_PAGES);
-    const long pageSize = ::sysconf(_SC_PAGESIZE);
-    return pages > 0 && pageSize > 0 ? std::uint64_t(pages) * std::uint64_t(pageSize) / 2 : std::uint64_t(1) << 31;
+    if (half == 0) {
+        const long pages = ::sysconf(_SC_AVPHYS_PAGES);
+        const long pageSize = ::sysconf(_SC_PAGESIZE);
+        half = pages > 0 && pageSize > 0 ? std::uint64_t(pages) * std::uint64_t(pageSize) / 2 : std::uint64_t(1) << 31;
+    }
+    return std::min(half, processMemoryHeadroom());
 }
 
 std::string formatBytes(std::uint64_t bytes) {
@@ -190,7 +263,7 @@ BakeStats bakeVdb(const Params& params, const std::string& path, const BakeOptio
     const auto start = std::chrono::steady_clock::now();
     validate(params);
     if (AtomicFile::lowercaseExtension(path) != ".vdb") throw ParamError("output.path", "'" + path + "' must end in .vdb");
-    AtomicFile file(path);  // fails now, before the work, if the folder is not writable
+    AtomicFile file(path, options.existing);  // fails now, before the work, if the folder is not writable
     StagedProgress staged(progress, options.monitor);
     BakeStats stats;
     openvdb::FloatGrid::Ptr surface = bakeLevelSet(params, options, bakeMemoryModel(params.bake), staged, stats, 0.7, 0.85);
@@ -214,10 +287,9 @@ BakeStats bakeVdb(const Params& params, const std::string& path, const BakeOptio
     metadata.insertMeta("dqjulia_parameters", openvdb::StringMetadata(toJson(params)));
     metadata.insertMeta("dqjulia_voxel_size", openvdb::DoubleMetadata(stats.voxelSize));
     try {
-        openvdb::io::File vdb(file.tempPath());
-        vdb.write(grids, metadata);
-        vdb.close();
+        CheckedVdbWriter().write(file.stream(), grids, metadata);
     } catch (const openvdb::Exception& error) {
+        if (!file.stream()) file.commit();  // throws with the write's reason ("No space left on device")
         throw std::runtime_error(AtomicFile::failureMessage(path, error.what()));
     }
     file.commit();

@@ -1,6 +1,8 @@
 // The C ABI: the only place that catches exceptions and turns them into status codes.
-// Handles are checked against a registry of live contexts, so a stale or garbage handle
-// gives DQJ_ERROR_INVALID_HANDLE instead of a crash.
+// Handles are numbers from a counter that never repeats, looked up in a table of live
+// contexts: a stale or garbage handle gives DQJ_ERROR_INVALID_HANDLE instead of a crash, and
+// cannot name a context created later at the same address. A context is marked busy while a
+// call on it runs, so it cannot be destroyed or used again from inside that call.
 #include "dqjulia/dqjulia.h"
 
 #include <algorithm>
@@ -9,7 +11,8 @@
 #include <mutex>
 #include <new>
 #include <string>
-#include <unordered_set>
+#include <memory>
+#include <unordered_map>
 
 #include "dqjulia/bake.hpp"
 #include "dqjulia/image.hpp"
@@ -30,24 +33,69 @@ struct dqj_context_t {
 
 namespace {
 
+struct Entry {
+    std::unique_ptr<dqj_context_t> context;
+    bool busy = false;
+};
+
 std::mutex registryMutex;
-std::unordered_set<const dqj_context_t*>& registry() {
-    static auto* live = new std::unordered_set<const dqj_context_t*>();  // never destroyed: safe at exit
+std::uint64_t lastHandle = 0;  // under registryMutex
+std::unordered_map<std::uintptr_t, Entry>& registry() {
+    static auto* live = new std::unordered_map<std::uintptr_t, Entry>();  // never destroyed: safe at exit
     return *live;
 }
 
-bool isLive(const dqj_context_t* context) {
-    if (!context) return false;
+std::uintptr_t handleValue(dqj_context handle) { return reinterpret_cast<std::uintptr_t>(handle); }
+
+/// The live context behind a handle, or null. Its pointer stays valid while it is busy (a busy
+/// context cannot be destroyed) or, for the readers of its texts, until it is destroyed.
+dqj_context_t* lookUp(dqj_context handle) {
+    if (!handle) return nullptr;
     std::lock_guard lock(registryMutex);
-    return registry().count(context) != 0;
+    const auto it = registry().find(handleValue(handle));
+    return it == registry().end() ? nullptr : it->second.context.get();
 }
 
 constexpr const char* kInvalidHandleMessage = "invalid dqjulia context (null, unknown or already destroyed)";
 
-/// Runs `body` for a live context, mapping every exception to a status and a message.
+/// Marks a context busy for the duration of one call.
+class BusyScope {
+public:
+    explicit BusyScope(dqj_context handle) : handle_(handle) {
+        if (!handle) return;
+        std::lock_guard lock(registryMutex);
+        const auto it = registry().find(handleValue(handle));
+        if (it == registry().end()) return;
+        if (it->second.busy) {
+            busy_ = true;
+            return;
+        }
+        it->second.busy = true;
+        context_ = it->second.context.get();
+    }
+    ~BusyScope() {
+        if (!context_) return;
+        std::lock_guard lock(registryMutex);
+        registry().at(handleValue(handle_)).busy = false;
+    }
+    BusyScope(const BusyScope&) = delete;
+    BusyScope& operator=(const BusyScope&) = delete;
+    dqj_context_t* context() const { return context_; }
+    bool busy() const { return busy_; }
+
+private:
+    dqj_context handle_;
+    dqj_context_t* context_ = nullptr;
+    bool busy_ = false;
+};
+
+/// Runs `body` for a live, idle context, mapping every exception to a status and a message.
 template <typename Body>
-dqj_status guarded(dqj_context context, Body&& body) {
-    if (!isLive(context)) return DQJ_ERROR_INVALID_HANDLE;
+dqj_status guarded(dqj_context handle, Body&& body) {
+    const BusyScope scope(handle);
+    if (scope.busy()) return DQJ_ERROR_BUSY;  // its own error text belongs to the running call
+    if (!scope.context()) return DQJ_ERROR_INVALID_HANDLE;
+    dqj_context_t* const context = scope.context();
     context->error.clear();
     context->warning.clear();
     try {
@@ -179,6 +227,7 @@ const char* dqj_status_string(dqj_status status) {
         case DQJ_ERROR_CANCELLED: return "cancelled";
         case DQJ_ERROR_OUT_OF_MEMORY: return "out of memory";
         case DQJ_ERROR_INTERNAL: return "internal error";
+        case DQJ_ERROR_BUSY: return "context busy (a call on it is running)";
     }
     return "unknown status";
 }
@@ -187,10 +236,12 @@ dqj_status dqj_context_create(dqj_context* outContext) {
     if (!outContext) return DQJ_ERROR_INVALID_ARGUMENT;
     *outContext = nullptr;
     try {
-        auto* context = new dqj_context_t();
+        auto context = std::make_unique<dqj_context_t>();
         std::lock_guard lock(registryMutex);
-        registry().insert(context);
-        *outContext = context;
+        // Odd numbers from a 64-bit counter: never 0 (NULL), never an address, never reused.
+        const std::uintptr_t handle = std::uintptr_t(2 * ++lastHandle + 1);
+        registry()[handle].context = std::move(context);
+        *outContext = reinterpret_cast<dqj_context>(handle);
         return DQJ_OK;
     } catch (const std::bad_alloc&) {
         return DQJ_ERROR_OUT_OF_MEMORY;
@@ -199,20 +250,29 @@ dqj_status dqj_context_create(dqj_context* outContext) {
     }
 }
 
-void dqj_context_destroy(dqj_context context) {
-    if (!context) return;
+dqj_status dqj_context_destroy(dqj_context handle) {
+    if (!handle) return DQJ_OK;
+    std::unique_ptr<dqj_context_t> doomed;  // deleted after the lock is released
     {
         std::lock_guard lock(registryMutex);
-        if (registry().erase(context) == 0) return;  // unknown or already destroyed: ignore
+        const auto it = registry().find(handleValue(handle));
+        if (it == registry().end()) return DQJ_ERROR_INVALID_HANDLE;  // unknown or already destroyed: ignored
+        if (it->second.busy) return DQJ_ERROR_BUSY;                  // from inside its own call: refused
+        doomed = std::move(it->second.context);
+        registry().erase(it);
     }
-    delete context;
+    return DQJ_OK;
 }
 
-const char* dqj_context_error(dqj_context context) {
-    return isLive(context) ? context->error.c_str() : kInvalidHandleMessage;
+const char* dqj_context_error(dqj_context handle) {
+    const dqj_context_t* context = lookUp(handle);
+    return context ? context->error.c_str() : kInvalidHandleMessage;
 }
 
-const char* dqj_context_warning(dqj_context context) { return isLive(context) ? context->warning.c_str() : ""; }
+const char* dqj_context_warning(dqj_context handle) {
+    const dqj_context_t* context = lookUp(handle);
+    return context ? context->warning.c_str() : "";
+}
 
 dqj_status dqj_context_load_params_file(dqj_context context, const char* path) {
     return guarded(context, [&](dqj_context_t& self) {
@@ -345,6 +405,12 @@ dqj_status dqj_render_to_file(dqj_context context, const char* path, dqj_progres
         dqj::Params params = paramsNow(self);
         params.output.path = path;
         dqj::validate(params);
+        try {
+            dqj::checkWritable(path);  // before the work, not after it
+        } catch (const std::exception& error) {
+            self.error = error.what();
+            return DQJ_ERROR_IO;
+        }
         const dqj::RenderResult result = dqj::render(params, wrapProgress(progress, userData));
         try {
             dqj::writeImage(result.image, path, dqj::formatFor(params.output));

@@ -19,6 +19,7 @@
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
+#include <ImfIO.h>
 #include <ImfOutputFile.h>
 #include <half.h>
 
@@ -57,8 +58,14 @@ void onPngError(png_structp png, png_const_charp message) {
 
 void onPngWarning(png_structp, png_const_charp) {}  // warnings (e.g. odd chunks) are not failures
 
-/// Writes RGB rows (8 or 16 bits per sample, 16-bit big-endian) with an sRGB chunk.
-bool writePngRows(std::FILE* file, png_uint_32 width, png_uint_32 height, int bitDepth, png_bytepp rows,
+void writeToStream(png_structp png, png_bytep data, png_size_t size) {
+    static_cast<std::ostream*>(png_get_io_ptr(png))->write(reinterpret_cast<const char*>(data), std::streamsize(size));
+}
+void flushStream(png_structp) {}  // AtomicFile::commit() flushes and checks
+
+/// Writes RGB rows (8 or 16 bits per sample, 16-bit big-endian) with an sRGB chunk to `out`
+/// (its errors are checked by the caller).
+bool writePngRows(std::ostream* out, png_uint_32 width, png_uint_32 height, int bitDepth, png_bytepp rows,
                   PngError* error) {
     png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, error, onPngError, onPngWarning);
     if (!png) return false;
@@ -71,7 +78,7 @@ bool writePngRows(std::FILE* file, png_uint_32 width, png_uint_32 height, int bi
         png_destroy_write_struct(&png, &info);
         return false;
     }
-    png_init_io(png, file);
+    png_set_write_fn(png, out, writeToStream, flushStream);
     png_set_IHDR(png, info, width, height, bitDepth, PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE,
                  PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
     png_set_sRGB_gAMA_and_cHRM(png, info, PNG_sRGB_INTENT_PERCEPTUAL);
@@ -155,7 +162,7 @@ void checkImage(const Image& image, const std::string& path) {
         throw std::runtime_error(AtomicFile::failureMessage(path, "the normal buffer has the wrong size"));
 }
 
-void writePng(const Image& image, const std::string& path, int bitDepth) {
+void writePng(const Image& image, const std::string& path, int bitDepth, Existing existing) {
     const std::size_t width = image.width;
     const std::size_t height = image.height;
     const std::size_t bytesPerSample = bitDepth == 16 ? 2 : 1;
@@ -176,25 +183,30 @@ void writePng(const Image& image, const std::string& path, int bitDepth) {
     std::vector<png_bytep> rows(height);
     for (std::size_t row = 0; row < height; ++row) rows[row] = &data[row * width * 3 * bytesPerSample];
 
-    AtomicFile target(path);
-    std::FILE* file = std::fopen(target.tempPath().c_str(), "wb");
-    if (!file) throw std::runtime_error(AtomicFile::failureMessage(path, std::strerror(errno)));
+    AtomicFile target(path, existing);
     PngError error;
-    errno = 0;
-    const bool written = writePngRows(file, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height),
-                                      bitDepth, rows.data(), &error);
-    const int writeErrno = errno;  // libpng's "Write Error" does not say why; fwrite's errno does
-    // fclose flushes: a full disk shows up here, not in libpng.
-    const bool flushed = std::fflush(file) == 0 && !std::ferror(file);
-    const int closeError = std::fclose(file) == 0 ? 0 : errno;
-    if (!written)
-        throw std::runtime_error(AtomicFile::failureMessage(
-            path, std::string(error.message) + (writeErrno ? std::string(": ") + std::strerror(writeErrno) : "")));
-    if (!flushed || closeError) throw std::runtime_error(AtomicFile::failureMessage(path, std::strerror(closeError ? closeError : EIO)));
-    target.commit();
+    if (!writePngRows(&target.stream(), static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), bitDepth,
+                      rows.data(), &error))
+        throw std::runtime_error(AtomicFile::failureMessage(path, error.message));
+    target.commit();  // reports a failed write (a full disk) with its reason
 }
 
-void writeExr(const Image& image, const std::string& path) {
+/// OpenEXR's output through AtomicFile's checked stream.
+class ExrStream : public Imf::OStream {
+public:
+    ExrStream(std::ostream& out, const std::string& path) : Imf::OStream(path.c_str()), out_(out) {}
+    void write(const char data[], int size) override {
+        out_.write(data, size);
+        if (!out_) throw std::runtime_error("write failed");  // the reason comes from commit()
+    }
+    std::uint64_t tellp() override { return std::uint64_t(out_.tellp()); }
+    void seekp(std::uint64_t position) override { out_.seekp(std::streamoff(position)); }
+
+private:
+    std::ostream& out_;
+};
+
+void writeExr(const Image& image, const std::string& path, Existing existing) {
     const std::size_t width = image.width;
     const std::size_t height = image.height;
     const std::size_t pixels = width * height;
@@ -240,12 +252,14 @@ void writeExr(const Image& image, const std::string& path) {
         }
     }
 
-    AtomicFile target(path);
+    AtomicFile target(path, existing);
     try {
-        Imf::OutputFile file(target.tempPath().c_str(), header);
+        ExrStream stream(target.stream(), path);
+        Imf::OutputFile file(stream, header);
         file.setFrameBuffer(frame);
         file.writePixels(image.height);
     } catch (const std::exception& error) {
+        if (!target.stream()) target.commit();  // throws with the write's reason ("No space left on device")
         throw std::runtime_error(AtomicFile::failureMessage(path, error.what()));
     }
     target.commit();
@@ -255,12 +269,12 @@ void writeExr(const Image& image, const std::string& path) {
 
 std::uint8_t linearToSrgb8(float linear) { return static_cast<std::uint8_t>(std::lround(encodeSrgb(linear) * 255.0)); }
 
-void writeImage(const Image& image, const std::string& path, ImageFormat format) {
+void writeImage(const Image& image, const std::string& path, ImageFormat format, Existing existing) {
     checkImage(image, path);
     switch (format) {
-        case ImageFormat::Png8: writePng(image, path, 8); return;
-        case ImageFormat::Png16: writePng(image, path, 16); return;
-        case ImageFormat::Exr: writeExr(image, path); return;
+        case ImageFormat::Png8: writePng(image, path, 8, existing); return;
+        case ImageFormat::Png16: writePng(image, path, 16, existing); return;
+        case ImageFormat::Exr: writeExr(image, path, existing); return;
     }
     throw std::runtime_error(AtomicFile::failureMessage(path, "unknown image format"));
 }

@@ -266,20 +266,15 @@ Mesh bakeMesh(const Params& params, const BakeOptions& options, const ProgressCa
     return mesh;
 }
 
-void writeMesh(const Mesh& mesh, const std::string& path) {
+void writeMesh(const Mesh& mesh, const std::string& path, Existing existing) {
     const std::string extension = AtomicFile::lowercaseExtension(path);
     if (extension != ".ply" && extension != ".obj")
         throw ParamError("output.path", "'" + path + "' must end in .ply or .obj");
-    AtomicFile file(path);
-    {
-        std::ofstream out(file.tempPath(), std::ios::binary | std::ios::trunc);
-        if (extension == ".ply")
-            writePly(mesh, out);
-        else
-            writeObj(mesh, out);
-        out.flush();
-        if (!out) throw std::runtime_error(AtomicFile::failureMessage(path, std::strerror(errno)));
-    }
+    AtomicFile file(path, existing);
+    if (extension == ".ply")
+        writePly(mesh, file.stream());
+    else
+        writeObj(mesh, file.stream());
     file.commit();
 }
 

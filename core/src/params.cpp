@@ -4,11 +4,16 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <set>
 #include <sstream>
+
+#include <fcntl.h>
+#include <unistd.h>
 
 #include <glm/geometric.hpp>
 #include <nlohmann/json.hpp>
@@ -18,7 +23,7 @@
 namespace dqj {
 
 ParamError::ParamError(std::string key, const std::string& message)
-    : std::runtime_error(message), key_(std::move(key)) {}
+    : std::runtime_error(printableText(message)), key_(std::move(key)) {}
 
 namespace {
 
@@ -39,16 +44,103 @@ std::size_t editDistance(const std::string& a, const std::string& b) {
     return previous[b.size()];
 }
 
-std::string describe(const Json& value) {
-    std::string text = value.dump();
-    if (text.size() > 40) text = text.substr(0, 37) + "...";
-    return std::string(value.type_name()) + " " + text;
+/// The first characters of `value` as JSON, written without recursion (a value may be nested
+/// as deep as the parser allows) and without serialising more than is shown.
+std::string preview(const Json& value, std::size_t limit) {
+    struct Frame {
+        const Json* node;
+        Json::const_iterator next;
+    };
+    std::string text;
+    std::vector<Frame> stack;
+    auto open = [&](const Json& node) {
+        if (!node.is_structured()) {
+            text += node.dump();
+            return;
+        }
+        text += node.is_object() ? '{' : '[';
+        stack.push_back({&node, node.begin()});
+    };
+    open(value);
+    while (!stack.empty() && text.size() <= limit) {
+        Frame& frame = stack.back();
+        if (frame.next == frame.node->end()) {
+            text += frame.node->is_object() ? '}' : ']';
+            stack.pop_back();
+            continue;
+        }
+        if (frame.next != frame.node->begin()) text += ',';
+        const auto item = frame.next++;
+        if (frame.node->is_object()) text += Json(item.key()).dump() + ":";
+        open(*item);  // may invalidate `frame`
+    }
+    if (text.size() > limit) text = text.substr(0, limit - 3) + "...";
+    return text;
 }
 
+std::string describe(const Json& value) { return std::string(value.type_name()) + " " + preview(value, 40); }
+
+/// Parses JSON with the limits of the format: at most kMaxParamsDepth levels of arrays and
+/// objects (deeper documents are refused before they can exhaust a stack) and no key twice in
+/// one object (nlohmann keeps the last silently). Errors name the dotted path of the key.
+Json parseLimited(const std::string& text, const std::string& source) {
+    struct Frame {
+        bool object = false;
+        std::size_t elements = 0;  // arrays: elements started so far
+        std::string key;           // objects: the current key
+        std::set<std::string> keys;
+    };
+    std::vector<Frame> frames;
+    auto path = [&](const std::string& last) {
+        std::string result;
+        for (const Frame& frame : frames) {
+            if (&frame == &frames.back() && frame.object) break;
+            if (frame.object)
+                result += (result.empty() ? "" : ".") + frame.key;
+            else if (frame.elements > 0)
+                result += "[" + std::to_string(frame.elements - 1) + "]";
+        }
+        return result.empty() ? last : last.empty() ? result : result + "." + last;
+    };
+    auto elementStarts = [&] {
+        if (!frames.empty() && !frames.back().object) ++frames.back().elements;
+    };
+    using Event = Json::parse_event_t;
+    return Json::parse(text, [&](int, Event event, Json& parsed) {
+        switch (event) {
+            case Event::object_start:
+            case Event::array_start:
+                elementStarts();
+                if (frames.size() >= std::size_t(kMaxParamsDepth))
+                    throw ParamError("", source + ": arrays and objects nested deeper than " + std::to_string(kMaxParamsDepth) +
+                                             " levels; a parameter file needs at most 4");
+                frames.emplace_back();
+                frames.back().object = event == Event::object_start;
+                break;
+            case Event::key: {
+                Frame& frame = frames.back();
+                frame.key = parsed.get<std::string>();
+                if (!frame.keys.insert(frame.key).second) {
+                    const std::string key = path(frame.key);
+                    throw ParamError(key, source + ": " + key + ": duplicate key \"" + frame.key +
+                                              "\" (a key may appear once in an object; the second would replace the first)");
+                }
+                break;
+            }
+            case Event::object_end:
+            case Event::array_end: frames.pop_back(); break;
+            case Event::value: elementStarts(); break;
+        }
+        return true;
+    });
+}
+
+/// The shortest text that reads back as exactly `value`, so a message never shows a value
+/// rounded onto its limit ("must be at most 1, got 1" for 1.0000001).
 std::string formatNumber(double value) {
-    std::ostringstream out;
-    out << value;
-    return out.str();
+    char text[64];
+    const auto result = std::to_chars(text, text + sizeof text, value);
+    return std::string(text, result.ptr);
 }
 
 /// Walks one JSON object: reads known keys with type and range checks, then rejects any key
@@ -171,7 +263,7 @@ Enum parseChoice(ObjectReader& reader, const Json& value, const std::string& key
     if (!value.is_string()) reader.fail(key, "must be one of " + allowed + ", got " + describe(value));
     for (const auto& [name, choice] : choices)
         if (value.get<std::string>() == name) return choice;
-    reader.fail(key, "must be one of " + allowed + ", got \"" + value.get<std::string>() + "\"");
+    reader.fail(key, "must be one of " + allowed + ", got " + value.dump());
 }
 
 constexpr std::array<std::pair<std::string_view, Variant>, 3> kVariants{
@@ -500,9 +592,12 @@ bool parallel(const glm::dvec3& a, const glm::dvec3& b) {
 }  // namespace
 
 Params parseParams(const std::string& jsonText, const std::string& source, Validation validation) {
+    if (jsonText.size() > kMaxParamsBytes)
+        throw ParamError("", source + ": the document has more than " + std::to_string(kMaxParamsBytes >> 20) +
+                                 " MiB; a parameter file is a few kilobytes");
     Json document;
     try {
-        document = Json::parse(jsonText);
+        document = parseLimited(jsonText, source);
     } catch (const Json::parse_error& error) {
         std::string reason = error.what();
         const std::size_t colon = reason.find(": ");  // drop "[json.exception.parse_error.101] parse error at ...: "
@@ -547,40 +642,89 @@ Params parseParams(const std::string& jsonText, const std::string& source, Valid
 }
 
 Params loadParams(const std::string& path, Validation validation) {
-    std::ifstream file(path, std::ios::binary);
-    if (!file) throw ParamError("", "cannot read parameter file '" + path + "': " + std::strerror(errno));
-    std::ostringstream text;
-    text << file.rdbuf();
-    if (file.bad()) throw ParamError("", "cannot read parameter file '" + path + "'");
-    return parseParams(text.str(), path, validation);
+    auto fail = [&](const std::string& reason) { return ParamError("", "cannot read parameter file '" + path + "': " + reason); };
+    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) throw fail(std::strerror(errno));
+    // Read at most one byte beyond the limit, so a never-ending file (/dev/zero, a stalled
+    // pipe's writer) cannot grow the buffer without bound. A signal (Ctrl-C) ends the read.
+    std::string text;
+    char chunk[65536];
+    int error = 0;
+    while (text.size() <= kMaxParamsBytes) {
+        const ssize_t got = ::read(fd, chunk, sizeof chunk);
+        if (got < 0) error = errno;
+        if (got <= 0) break;
+        text.append(chunk, std::size_t(got));
+    }
+    ::close(fd);
+    if (error == EINTR) throw fail("interrupted");
+    if (error) throw fail(std::strerror(error));
+    if (text.size() > kMaxParamsBytes)
+        throw fail("larger than " + std::to_string(kMaxParamsBytes >> 20) + " MiB; a parameter file is a few kilobytes");
+    return parseParams(text, path, validation);
 }
 
 void validate(const Params& params) {
     auto fail = [](const std::string& key, const std::string& message) { throw ParamError(key, key + ": " + message); };
     const Fractal& fractal = params.fractal;
+    // The ranges here are the parameter file's, so whatever passes (from flags or the C ABI)
+    // is written by --save-params as a file that reads back.
     for (int index = 0; index < 8; ++index)
-        if (!std::isfinite(component(fractal.c, index))) fail("fractal.c", "every component must be a finite number");
+        if (!(std::abs(component(fractal.c, index)) <= 100.0))
+            fail("fractal.c", "every component must be a finite number from -100 to 100");
     if (fractal.iterations < 1 || fractal.iterations > 100000) fail("fractal.iterations", "must be from 1 to 100000");
+    if (!(fractal.bailout > 1.0 && fractal.bailout <= 1e150))
+        fail("fractal.bailout", "must be a finite number greater than 1 and at most 1e150, got " + formatNumber(fractal.bailout));
     const double needed = minimumBailout(fractal);
-    if (!(fractal.bailout >= needed) || !std::isfinite(fractal.bailout))
+    if (!(fractal.bailout >= needed))
         fail("fractal.bailout", "is " + formatNumber(fractal.bailout) + " but must be at least the containment radius r_K = " +
                                     formatNumber(needed) + " of this constant and variant (points inside r_K may still be in the set)");
 
     const Slice slice = params.slice.effective();
     for (int axis = 0; axis < 3; ++axis)
         for (int index = 0; index < 8; ++index)
-            if (!std::isfinite(slice.axes[axis][index]) || !std::isfinite(slice.origin[index]))
-                fail("slice", "origin and axes must be finite numbers");
-    for (const PlaneRotation& rotation : params.slice.rotations)
+            if (!(std::abs(params.slice.base.axes[axis][index]) <= 1e9) || !(std::abs(params.slice.base.origin[index]) <= 1e9))
+                fail("slice", "origin and axes must be finite numbers from -1e9 to 1e9");
+    for (const PlaneRotation& rotation : params.slice.rotations) {
         if (rotation.first == rotation.second || rotation.first < 0 || rotation.first > 7 || rotation.second < 0 || rotation.second > 7)
             fail("slice.rotations", "a rotation plane must name two different axes");
+        if (!(std::abs(rotation.degrees) <= 36000.0)) fail("slice.rotations", "degrees must be finite numbers from -36000 to 36000");
+    }
     const Stretch stretch = stretchOf(slice);
     if (stretch.min < 1e-9 * std::max(1.0, stretch.max))
         fail("slice.axes", "the three axes are zero or parallel, so the slice is not 3-D; give three independent axes");
+    // Linearly dependent axes (z = x + y) span a plane: the Gram determinant vanishes against
+    // the product of the squared lengths (Hadamard's bound; 1 for orthogonal axes).
+    {
+        double gram[3][3] = {};
+        for (int row = 0; row < 3; ++row)
+            for (int column = 0; column < 3; ++column)
+                for (int index = 0; index < 8; ++index) gram[row][column] += slice.axes[row][index] * slice.axes[column][index];
+        const double determinant = gram[0][0] * (gram[1][1] * gram[2][2] - gram[1][2] * gram[2][1]) -
+                                   gram[0][1] * (gram[1][0] * gram[2][2] - gram[1][2] * gram[2][0]) +
+                                   gram[0][2] * (gram[1][0] * gram[2][1] - gram[1][1] * gram[2][0]);
+        if (!(determinant > 1e-10 * gram[0][0] * gram[1][1] * gram[2][2]))
+            fail("slice.axes", "the three axes are linearly dependent (one is a combination of the others), so the slice "
+                               "is a plane, not 3-D; give three independent axes");
+    }
 
     if (params.bounds && !(params.bounds->radius > 0.0)) fail("bounds.radius", "must be greater than 0");
 
+    auto finite3 = [](const glm::dvec3& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+    // Camera vectors within the parameter file's range (+-1e9), so lengths and directions
+    // computed from them stay finite and exact enough to aim a ray.
+    auto sane3 = [&](const glm::dvec3& v) { return finite3(v) && std::abs(v.x) <= 1e9 && std::abs(v.y) <= 1e9 && std::abs(v.z) <= 1e9; };
+    if (params.bounds && (!sane3(params.bounds->center) || !(params.bounds->radius <= 1e6)))
+        fail("bounds", "center must be 3 finite numbers from -1e9 to 1e9 and radius at most 1e6");
     const Camera& camera = params.camera;
+    if (camera.position && !sane3(*camera.position)) fail("camera.position", "must be 3 finite numbers from -1e9 to 1e9");
+    if (camera.target && !sane3(*camera.target)) fail("camera.target", "must be 3 finite numbers from -1e9 to 1e9");
+    if (!sane3(camera.direction)) fail("camera.direction", "must be 3 finite numbers from -1e9 to 1e9");
+    if (!sane3(camera.up)) fail("camera.up", "must be 3 finite numbers from -1e9 to 1e9");
+    for (std::size_t index = 0; index < params.lights.size(); ++index)
+        if (!finite3(params.lights[index].direction) || !finite3(params.lights[index].color) ||
+            !std::isfinite(params.lights[index].intensity))
+            fail("lights[" + std::to_string(index) + "]", "direction, color and intensity must be finite numbers");
     if (!(camera.fovDegrees > 0.0 && camera.fovDegrees < 170.0)) fail("camera.fov", "must be between 0 and 170 degrees");
     if (glm::length(camera.up) == 0.0) fail("camera.up", "must not be the zero vector");
     glm::dvec3 forward;
@@ -606,9 +750,9 @@ void validate(const Params& params) {
         fail("render.width", "width and height must be from 1 to 16384");
     if (render.samples < 1 || render.samples > 16) fail("render.samples", "must be from 1 to 16");
     if (!(render.stepFactor > 0.0 && render.stepFactor <= 1.0)) fail("render.step_factor", "must be greater than 0 and at most 1");
-    if (!(render.maxStep > 0.0)) fail("render.max_step", "must be greater than 0");
-    if (render.maxSteps < 1) fail("render.max_steps", "must be at least 1");
-    if (!(render.detail > 0.0)) fail("render.detail", "must be greater than 0");
+    if (!(render.maxStep > 0.0 && render.maxStep <= 1e6)) fail("render.max_step", "must be greater than 0 and at most 1e6");
+    if (render.maxSteps < 1 || render.maxSteps > 1000000) fail("render.max_steps", "must be from 1 to 1000000");
+    if (!(render.detail > 0.0 && render.detail <= 1000.0)) fail("render.detail", "must be greater than 0 and at most 1000");
     if (render.normals == NormalMethod::Analytic && fractal.variant != Variant::Dual)
         fail("render.normals", "\"analytic\" normals come from the dual part of the true algebra and need variant \"dual\"; "
                                "use \"central\" or \"auto\" with variant \"" + std::string(variantName(fractal.variant)) + "\"");
@@ -624,9 +768,9 @@ void validate(const Params& params) {
     if (bake.resolution < 8 || bake.resolution > 16384) fail("bake.resolution", "must be a whole number from 8 to 16384");
     if (bake.bounds) {
         for (int axis = 0; axis < 3; ++axis)
-            if (!(bake.bounds->min[axis] < bake.bounds->max[axis]) || !std::isfinite(bake.bounds->min[axis]) ||
-                !std::isfinite(bake.bounds->max[axis]))
-                fail("bake.bounds", "min must be below max on every axis (x, y, z), with finite numbers");
+            if (!(bake.bounds->min[axis] < bake.bounds->max[axis]) || !(std::abs(bake.bounds->min[axis]) <= 1e6) ||
+                !(std::abs(bake.bounds->max[axis]) <= 1e6))
+                fail("bake.bounds", "min must be below max on every axis (x, y, z), with finite numbers from -1e6 to 1e6");
     }
     if (!(bake.bandWidth >= 1.0 && bake.bandWidth <= 32.0)) fail("bake.band_width", "must be from 1 to 32 voxels");
     if (bake.grids.empty()) fail("bake.grids", "must name at least one grid");
@@ -742,14 +886,10 @@ std::string toJson(const Params& params) {
     return compactNumberArrays(document.dump(2)) + "\n";
 }
 
-void saveParams(const Params& params, const std::string& path) {
-    AtomicFile target(path);
-    {
-        std::ofstream file(target.tempPath(), std::ios::binary | std::ios::trunc);
-        file << toJson(params);
-        file.flush();
-        if (!file) throw std::runtime_error(AtomicFile::failureMessage(path, std::strerror(errno)));
-    }
+void saveParams(const Params& params, const std::string& path, Existing existing) {
+    const std::string text = toJson(params);
+    AtomicFile target(path, existing);
+    target.stream() << text;
     target.commit();
 }
 

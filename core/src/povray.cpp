@@ -154,7 +154,7 @@ SceneFacts resolve(const Params& params) {
 void writeHeader(std::ostringstream& out, const Params& params, const PovraySceneOptions& options,
                  const std::string& kind) {
     out << "// dqjulia scene for POV-Ray 3.7, written by `dqjulia povray` (dqjulia " << povString(DQJ_VERSION_STRING_FROM_BUILD)
-        << ")" << (options.sourceName.empty() ? "" : " from " + options.sourceName) << ".\n";
+        << ")" << (options.sourceName.empty() ? "" : " from " + povString(options.sourceName)) << ".\n";
     if (!params.description.empty()) out << commentBlock(params.description);
     out << "//\n" << commentBlock(kind);
     out << "//\n// Render (" << options.includeName
@@ -355,13 +355,6 @@ std::string buildScene(const Params& params, const PovraySceneOptions& options) 
     return out.str();
 }
 
-void writeText(const std::string& text, AtomicFile& file) {
-    std::ofstream stream(file.tempPath(), std::ios::binary | std::ios::trunc);
-    stream << text;
-    stream.flush();
-    if (!stream) throw std::runtime_error(AtomicFile::failureMessage(file.path(), "write failed"));
-}
-
 }  // namespace
 
 std::string_view povrayInclude() { return kPovrayIncludeText; }
@@ -412,7 +405,7 @@ DensityGrid bakeDensityGrid(const Params& params, int resolution, const Progress
     return grid;
 }
 
-void writeDf3(const DensityGrid& grid, const std::string& path, int bits) {
+void writeDf3(const DensityGrid& grid, const std::string& path, int bits, Existing existing) {
     if (bits != 8 && bits != 16 && bits != 32)
         throw std::invalid_argument("DF3 samples are 8, 16 or 32 bits, got " + std::to_string(bits));
     if (grid.resolution < 1 || grid.resolution > 65535 ||
@@ -431,13 +424,8 @@ void writeDf3(const DensityGrid& grid, const std::string& path, int bits) {
         const auto code = static_cast<std::uint32_t>(std::lround(clamped * maximum));
         for (int byte = bytes - 1; byte >= 0; --byte) data.push_back(static_cast<unsigned char>(code >> (8 * byte)));
     }
-    AtomicFile file(path);
-    {
-        std::ofstream stream(file.tempPath(), std::ios::binary | std::ios::trunc);
-        stream.write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size()));
-        stream.flush();
-        if (!stream) throw std::runtime_error(AtomicFile::failureMessage(path, "write failed"));
-    }
+    AtomicFile file(path, existing);
+    file.stream().write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size()));
     file.commit();
 }
 
@@ -454,6 +442,14 @@ PovrayFiles povrayFiles(const Params& params, const std::string& scenePath, cons
     if (options.df3) {
         files.df3 = stem + ".df3";
         files.df3Scene = stem + "_df3.pov";
+        // The DF3 scene names the grid file in a POV-Ray string, which carries printable
+        // ASCII only (POV-Ray 3.7 reads strings as ASCII; quotes and backslashes are escapes).
+        for (const char ch : fs::path(files.df3).filename().string())
+            if (ch < 0x20 || ch > 0x7e || ch == '"' || ch == '\\')
+                throw ParamError("output.path", "'" + scenePath + "': with --df3 the scene names the grid file '" +
+                                                    fs::path(files.df3).filename().string() +
+                                                    "' in a POV-Ray string, which carries only printable ASCII "
+                                                    "characters without \" and \\; rename the scene");
     }
     if (options.copyInclude) files.include = (folder / "dqjulia.inc").string();
     return files;
@@ -484,14 +480,14 @@ std::vector<std::string> writePovray(const Params& params, const std::string& sc
 
     std::vector<std::string> written;
     auto writeFile = [&](const std::string& path, const std::string& text) {
-        AtomicFile file(path);
-        writeText(text, file);
+        AtomicFile file(path, options.existing);
+        file.stream() << text;
         file.commit();
         written.push_back(path);
     };
     if (!files.scene.empty()) writeFile(files.scene, sceneText);
     if (options.df3) {
-        writeDf3(grid, files.df3, options.df3Bits);
+        writeDf3(grid, files.df3, options.df3Bits, options.existing);
         written.push_back(files.df3);
         writeFile(files.df3Scene, df3SceneText);
     }

@@ -130,7 +130,16 @@ public:
             dense_ *= std::uint64_t(std::max<long long>(1, std::llround((box.max[axis] - box.min[axis]) / h_)));
         }
         indexBox_ = CoordBBox(lo_, hi_);
-        limit_ = options.memoryLimit ? options.memoryLimit : defaultMemoryLimit();
+        // An explicit limit too is capped by what the process may really allocate (ulimit -v,
+        // cgroups): beyond that the bake would fail late with an allocation error.
+        const std::uint64_t processLimit = processMemoryHeadroom();
+        const std::uint64_t requested = options.memoryLimit ? options.memoryLimit : defaultMemoryLimit();
+        limit_ = std::min(requested, processLimit);
+        processLimited_ = processLimit <= requested;  // defaultMemoryLimit() too may be the process limit
+        limitSource_ = processLimited_ ? " (what this process may still allocate under its memory limits: ulimit -v, "
+                                                "ulimit -d or its cgroup's memory.max)"
+                       : options.memoryLimit ? ""
+                                             : " (half of the available memory)";
     }
 
     SampledSurface run(double split, double end) {
@@ -327,13 +336,14 @@ private:
         const std::uint64_t estimate = estimateFor(leaves);
         if (final) stats_.estimatedBytes = estimate;
         if (estimate <= limit_) return;
-        const std::string limit = formatBytes(limit_) + (options_.memoryLimit ? "" : " (half of the available memory)");
+        const std::string limit = formatBytes(limit_) + limitSource_;
         const std::string blocks = std::to_string(leaves) + " blocks of 8^3 voxels to sample";
         throw MemoryLimitError("resolution " + std::to_string(params_.bake.resolution) +
                                    (final ? " needs an estimated " + formatBytes(estimate) + " (" + blocks + "), more than the limit of " + limit
                                           : " needs more than the limit of " + limit + ": the first " + blocks + " already need " +
                                                 formatBytes(estimate)) +
-                                   "; lower the resolution, bake a smaller region (bake.bounds) or raise the limit (--max-memory)",
+                                   (processLimited_ ? std::string("; lower the resolution, bake a smaller region (bake.bounds) or raise the process's limit")
+                                                    : std::string("; lower the resolution, bake a smaller region (bake.bounds) or raise the limit (--max-memory)")),
                                estimate, limit_);
     }
 
@@ -347,6 +357,8 @@ private:
     CoordBBox indexBox_;
     std::uint64_t dense_ = 1;
     std::uint64_t limit_ = 0;
+    std::string limitSource_;  // why the limit is what it is, for the message
+    bool processLimited_ = false;
     std::atomic<std::uint64_t> evaluated_{0};
     openvdb::Int32Tree states_{kSkipped};  // keyed by leaf (origin / 8)
     BakeStats stats_;

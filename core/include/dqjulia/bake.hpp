@@ -43,6 +43,7 @@ struct BakeOptions {
     bool dense = false;             ///< evaluate every voxel, skip nothing (for comparisons and tests)
     std::uint64_t memoryLimit = 0;  ///< refuse above this estimate, in bytes; 0 = defaultMemoryLimit()
     BakeMonitor* monitor = nullptr; ///< optional live counters
+    Existing existing = Existing::Replace;  ///< bakeVdb: replace an existing file, or keep it and fail
 };
 
 struct BakeStats {
@@ -70,7 +71,12 @@ private:
     std::uint64_t limit_;
 };
 
-/// Half of the memory the system reports available (MemAvailable) right now.
+/// What this process may still allocate under its own limits: RLIMIT_AS and RLIMIT_DATA
+/// (ulimit -v, ulimit -d) less what it uses, and the memory.max (cgroup v2) or
+/// memory.limit_in_bytes (v1) of its cgroups less their usage. UINT64_MAX when unlimited.
+DQJ_API std::uint64_t processMemoryHeadroom();
+/// Half of the memory the system reports available (MemAvailable) right now, at most
+/// processMemoryHeadroom().
 DQJ_API std::uint64_t defaultMemoryLimit();
 /// "1.5 GB", "312 MB", ...
 DQJ_API std::string formatBytes(std::uint64_t bytes);

@@ -7,13 +7,16 @@
  * - Every call returns a dqj_status; on failure dqj_context_error() tells why. There is
  *   no global error buffer, and no C++ exception ever crosses this boundary.
  * - Null pointers and unknown or destroyed handles give DQJ_ERROR_INVALID_HANDLE or
- *   DQJ_ERROR_INVALID_ARGUMENT, never a crash.
+ *   DQJ_ERROR_INVALID_ARGUMENT, never a crash. A handle is a number that is never reused, so
+ *   a destroyed handle stays invalid even after new contexts are created.
+ * - A context is busy while one of its calls runs: another call on it (from its progress
+ *   callback, or from another thread) and dqj_context_destroy() return DQJ_ERROR_BUSY.
  * - Buffers are the caller's: sizes are queried first, then filled.
  *
  * Thread safety: dqj_version*() and dqj_status_string() may be called from any thread.
  * Separate contexts are independent and may be used from different threads at the same
- * time. One context must not be used from two threads at once (calls on it are not
- * serialised); its progress callback runs on the thread that called dqj_render*(),
+ * time. One context is used by one call at a time (a second call meanwhile is refused with
+ * DQJ_ERROR_BUSY, not queued); its progress callback runs on the thread that called dqj_render*(),
  * dqj_bake_vdb() or dqj_mesh_compute().
  */
 #ifndef DQJULIA_H
@@ -47,7 +50,8 @@ typedef enum dqj_status {
     DQJ_ERROR_IO = 4,               /* a file could not be read or written */
     DQJ_ERROR_CANCELLED = 5,        /* the progress callback asked to stop */
     DQJ_ERROR_OUT_OF_MEMORY = 6,
-    DQJ_ERROR_INTERNAL = 7
+    DQJ_ERROR_INTERNAL = 7,
+    DQJ_ERROR_BUSY = 8              /* a call on this context is running (e.g. from its progress callback) */
 } dqj_status;
 
 /* A short English name for a status ("invalid handle"); never NULL. */
@@ -63,8 +67,11 @@ typedef struct dqj_context_t* dqj_context;
 
 /* Creates a context holding the default parameters. */
 DQJ_API dqj_status dqj_context_create(dqj_context* out_context);
-/* Destroys a context; NULL is ignored. The handle is invalid afterwards. */
-DQJ_API void dqj_context_destroy(dqj_context context);
+/* Destroys a context; the handle is invalid afterwards. NULL, unknown and destroyed handles
+ * are ignored (DQJ_ERROR_INVALID_HANDLE; DQJ_OK for NULL). While a call on the context runs
+ * (destroying it from its own progress callback), nothing happens and DQJ_ERROR_BUSY is
+ * returned: destroy it after the call returns. */
+DQJ_API dqj_status dqj_context_destroy(dqj_context context);
 /* The message of the context's last failed call ("" if none). Valid until the next call on
  * the context. For an invalid handle, a static text saying so. */
 DQJ_API const char* dqj_context_error(dqj_context context);

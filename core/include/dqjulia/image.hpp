@@ -26,10 +26,12 @@ struct Image {
 /// Linear [0, 1] to an 8-bit sRGB code (clamped, rounded). The one sRGB encoder of the library.
 DQJ_API std::uint8_t linearToSrgb8(float linear);
 
-/// Writes `image` to `path` in `format`. The file is written to a temporary file in the same
-/// folder and renamed into place, so a failure never leaves a partial file or destroys an
-/// existing one. Throws std::runtime_error naming the path and the cause.
-DQJ_API void writeImage(const Image& image, const std::string& path, ImageFormat format);
+/// Writes `image` to `path` in `format`. The file is written to an unnamed temporary file in
+/// the same folder, every write checked, and published only when complete, so a failure never
+/// leaves a partial file or destroys an existing one. `existing`: replace an existing file or
+/// keep it (and fail). Throws std::runtime_error naming the path and the cause.
+DQJ_API void writeImage(const Image& image, const std::string& path, ImageFormat format,
+                        Existing existing = Existing::Replace);
 
 /// Reads an 8- or 16-bit PNG into linear RGBA floats (depth and normal stay empty).
 /// Throws std::runtime_error.

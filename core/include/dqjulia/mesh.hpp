@@ -46,6 +46,6 @@ DQJ_API Mesh bakeMesh(const Params& params, const BakeOptions& options = {}, con
 /// quads and triangles) or `.obj` (text: `v x y z [r g b]`, `vn`, `f a//a ...`), by the path's
 /// extension. Temporary file + rename. Throws ParamError for another extension,
 /// std::runtime_error for I/O.
-DQJ_API void writeMesh(const Mesh& mesh, const std::string& path);
+DQJ_API void writeMesh(const Mesh& mesh, const std::string& path, Existing existing = Existing::Replace);
 
 }  // namespace dqj

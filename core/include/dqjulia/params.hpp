@@ -143,6 +143,21 @@ private:
 
 enum class Validation { Full, TypesOnly };
 
+/// What a writer does with an existing file at its path: replace it atomically, or keep it
+/// and fail (also when the file appears while the work runs; the CLI without --force).
+enum class Existing { Replace, Keep };
+
+/// Checks, before long work, that `path` can be written: a new or regular file (not a folder,
+/// device, FIFO or socket), not existing when `existing` is Keep, in a folder where a file can
+/// really be created (tried, so read-only and special file systems fail now). Throws
+/// std::runtime_error ("cannot write 'path': reason").
+DQJ_API void checkWritable(const std::string& path, Existing existing = Existing::Replace);
+
+/// The largest parameter document read (16 MiB) and the deepest nesting of arrays and objects
+/// in it (64 levels; the format needs 4).
+inline constexpr std::size_t kMaxParamsBytes = 16u << 20;
+inline constexpr int kMaxParamsDepth = 64;
+
 /// Parses a parameter document: types, ranges and key names always; the cross-field rules of
 /// validate() too unless `validation` is TypesOnly (for callers that override values first,
 /// such as the CLI's flags, and validate afterwards). `source` names the document in messages.
@@ -155,7 +170,7 @@ DQJ_API Params loadParams(const std::string& path, Validation validation = Valid
 DQJ_API std::string toJson(const Params& params);
 /// Writes toJson(params) to `path` through a temporary file in the same folder, so a failure
 /// never leaves a partial file. Throws std::runtime_error naming the path.
-DQJ_API void saveParams(const Params& params, const std::string& path);
+DQJ_API void saveParams(const Params& params, const std::string& path, Existing existing = Existing::Replace);
 /// Checks the cross-field rules (bailout >= r_K, non-degenerate slice, camera, ...). Throws ParamError.
 DQJ_API void validate(const Params& params);
 

@@ -51,7 +51,8 @@ DQJ_API DensityGrid bakeDensityGrid(const Params& params, int resolution, const 
 /// Writes a DF3 file: three big-endian 16-bit sizes, then the samples as big-endian unsigned
 /// integers of `bits` (8, 16 or 32) bits, x fastest. Written to a temporary file and renamed.
 /// Throws std::invalid_argument for other bit depths, std::runtime_error if it cannot write.
-DQJ_API void writeDf3(const DensityGrid& grid, const std::string& path, int bits = 16);
+DQJ_API void writeDf3(const DensityGrid& grid, const std::string& path, int bits = 16,
+                      Existing existing = Existing::Replace);
 
 struct PovraySceneOptions {
     std::string includeName = "dqjulia.inc";  ///< as written in #include
@@ -78,6 +79,7 @@ struct PovrayWriteOptions {
     int df3Resolution = 128;
     int df3Bits = 16;
     std::string sourceName;   ///< for the scenes' header comment
+    Existing existing = Existing::Replace;  ///< replace existing files, or keep them and fail
 };
 
 /// The files writePovray() writes for `scenePath`; an empty path is not written. The scene is

@@ -1,0 +1,109 @@
+/* fault_shim.c - an LD_PRELOAD library that makes writes into one folder fail, for the
+ * fault-injection tests (hostile_input_test.cpp).
+ *
+ * It replaces glibc's write, fsync and close, so it works whatever the program links
+ * statically (OpenVDB, TBB, libpng) as long as glibc itself is a shared library. Only
+ * descriptors whose file lies in DQJ_FAULT_DIR are touched (an O_TMPFILE shows up there as
+ * "DIR/#123 (deleted)"); everything else passes through. Settings, from the environment:
+ *   DQJ_FAULT_DIR    the folder (absolute path)
+ *   DQJ_FAULT_MODE   enospc: writes fail with ENOSPC once DQJ_FAULT_AFTER bytes were written;
+ *                    short:  every write there writes at most half its bytes (at least 1), and
+ *                            fails with ENOSPC after DQJ_FAULT_AFTER bytes;
+ *                    fsync:  fsync fails with EIO;  close: close fails with EIO.
+ *   DQJ_FAULT_AFTER  bytes allowed before writes fail (default 0)
+ *   DQJ_FAULT_NO_TMPFILE=1  open(O_TMPFILE) fails with EOPNOTSUPP, as on a file system
+ *                    without it, so the writer's fallback (a hidden, locked name) is tested
+ */
+#define _GNU_SOURCE
+#include <dlfcn.h>
+#include <errno.h>
+#include <fcntl.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+static long long written_so_far;
+
+static int in_fault_dir(int fd) {
+    const char* dir = getenv("DQJ_FAULT_DIR");
+    if (!dir || !*dir) return 0;
+    char link[64], target[4096];
+    snprintf(link, sizeof link, "/proc/self/fd/%d", fd);
+    const ssize_t length = readlink(link, target, sizeof target - 1);
+    if (length <= 0) return 0;
+    target[length] = '\0';
+    const size_t dirLength = strlen(dir);
+    return strncmp(target, dir, dirLength) == 0 && target[dirLength] == '/';
+}
+
+static int mode_is(const char* mode) {
+    const char* value = getenv("DQJ_FAULT_MODE");
+    return value && strcmp(value, mode) == 0;
+}
+
+ssize_t write(int fd, const void* data, size_t size) {
+    static ssize_t (*real_write)(int, const void*, size_t);
+    if (!real_write) real_write = (ssize_t(*)(int, const void*, size_t))dlsym(RTLD_NEXT, "write");
+    if (size > 0 && (mode_is("enospc") || mode_is("short")) && in_fault_dir(fd)) {
+        const char* after = getenv("DQJ_FAULT_AFTER");
+        const long long allowed = after ? atoll(after) : 0;
+        if (written_so_far >= allowed) {
+            errno = ENOSPC;
+            return -1;
+        }
+        if (mode_is("short") && size > 1) size /= 2;
+        if ((long long)size > allowed - written_so_far) size = (size_t)(allowed - written_so_far);
+        const ssize_t done = real_write(fd, data, size);
+        if (done > 0) written_so_far += done;
+        return done;
+    }
+    return real_write(fd, data, size);
+}
+
+static int refuse_tmpfile(int flags) {
+    const char* value = getenv("DQJ_FAULT_NO_TMPFILE");
+    return (flags & O_TMPFILE) == O_TMPFILE && value && strcmp(value, "1") == 0;
+}
+
+#define DQJ_OPEN_WRAPPER(name)                                                       \
+    int name(const char* path, int flags, ...) {                                     \
+        static int (*real)(const char*, int, ...);                                   \
+        if (!real) real = (int (*)(const char*, int, ...))dlsym(RTLD_NEXT, #name);   \
+        mode_t mode = 0;                                                             \
+        if (flags & (O_CREAT | O_TMPFILE)) {                                         \
+            va_list arguments;                                                       \
+            va_start(arguments, flags);                                              \
+            mode = va_arg(arguments, mode_t);                                        \
+            va_end(arguments);                                                       \
+        }                                                                            \
+        if (refuse_tmpfile(flags)) {                                                 \
+            errno = EOPNOTSUPP;                                                      \
+            return -1;                                                               \
+        }                                                                            \
+        return real(path, flags, mode);                                              \
+    }
+DQJ_OPEN_WRAPPER(open)
+DQJ_OPEN_WRAPPER(open64)
+
+int fsync(int fd) {
+    static int (*real_fsync)(int);
+    if (!real_fsync) real_fsync = (int (*)(int))dlsym(RTLD_NEXT, "fsync");
+    if (mode_is("fsync") && in_fault_dir(fd)) {
+        errno = EIO;
+        return -1;
+    }
+    return real_fsync(fd);
+}
+
+int close(int fd) {
+    static int (*real_close)(int);
+    if (!real_close) real_close = (int (*)(int))dlsym(RTLD_NEXT, "close");
+    if (mode_is("close") && in_fault_dir(fd)) {
+        real_close(fd); /* the descriptor is gone either way, as with a real failing close */
+        errno = EIO;
+        return -1;
+    }
+    return real_close(fd);
+}

@@ -1,0 +1,535 @@
+// Hostile input: one test per class of failure the hostile-input probe (issue 12) found, each
+// asserting the exit status (or C status), the message and the files left behind; and fault
+// injection (fault_shim.c) into every writer at several points.
+#include <gtest/gtest.h>
+
+#include <pthread.h>
+#include <signal.h>
+#include <sys/mount.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "dqjulia/dqjulia.h"
+#include "test_support.hpp"
+
+namespace fs = std::filesystem;
+using dqj::test::readFile;
+
+namespace {
+
+class Hostile : public ::testing::Test {
+protected:
+    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_hostile"); }
+    void TearDown() override {
+        if (mounted_) ::umount(mount_.c_str());
+        fs::remove_all(dir_);
+    }
+    dqj::test::CommandResult run(const std::string& arguments, const std::string& input = "") {
+        return dqj::test::runCommand(DQJ_CLI, arguments, dir_, input);
+    }
+    std::string path(const std::string& name) const { return "'" + (dir_ / name).string() + "'"; }
+    std::set<std::string> filesIn(const fs::path& folder) const {
+        std::set<std::string> names;
+        for (const auto& entry : fs::directory_iterator(folder)) names.insert(entry.path().filename().string());
+        return names;
+    }
+    void write(const std::string& name, const std::string& text) const { std::ofstream(dir_ / name, std::ios::binary) << text; }
+    /// A small tmpfs at dir_/name of `size` (e.g. "64k"); false if mounting is not allowed here.
+    bool mountTmpfs(const std::string& name, const std::string& size) {
+        mount_ = dir_ / name;
+        fs::create_directories(mount_);
+        mounted_ = ::mount("tmpfs", mount_.c_str(), "tmpfs", 0, ("size=" + size).c_str()) == 0;
+        return mounted_;
+    }
+
+    fs::path dir_;
+    fs::path mount_;
+    bool mounted_ = false;
+};
+
+#define EXPECT_CONTAINS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << "in: " << (text)
+
+int waitExit(pid_t pid) {
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+}
+
+bool hasTemporary(const std::set<std::string>& names) {
+    for (const std::string& name : names)
+        if (name.find(".tmp-") != std::string::npos) return true;
+    return false;
+}
+
+// --- Data loss: a full disk, a truncated VDB -------------------------------------------
+
+TEST_F(Hostile, BakeOntoAFullDiskFailsAndKeepsTheOldFile) {
+    if (!mountTmpfs("disk", "96k")) GTEST_SKIP() << "cannot mount a tmpfs here: " << std::strerror(errno);
+    const fs::path vdb = mount_ / "fractal.vdb";
+    std::ofstream(vdb) << "old bake";
+    for (int attempt = 0; attempt < 2; ++attempt) {  // twice: the second run must not leave 0 bytes either
+        const auto result = run("bake -q --force -r 64 -o '" + vdb.string() + "'");
+        EXPECT_EQ(result.exitCode, 1) << result.err;
+        EXPECT_CONTAINS(result.err, "No space left on device");
+        EXPECT_EQ(readFile(vdb), "old bake");
+        EXPECT_EQ(filesIn(mount_), std::set<std::string>{"fractal.vdb"});
+    }
+}
+
+int keepGoing(double, void*) { return 0; }
+
+TEST_F(Hostile, CBakeOntoAFullDiskReturnsAnIoError) {
+    if (!mountTmpfs("disk", "96k")) GTEST_SKIP() << "cannot mount a tmpfs here: " << std::strerror(errno);
+    dqj_context context = nullptr;
+    ASSERT_EQ(dqj_context_create(&context), DQJ_OK);
+    ASSERT_EQ(dqj_context_set_bake_resolution(context, 64), DQJ_OK);
+    const std::string vdb = (mount_ / "fractal.vdb").string();
+    EXPECT_EQ(dqj_bake_vdb(context, vdb.c_str(), keepGoing, nullptr), DQJ_ERROR_IO);
+    EXPECT_CONTAINS(dqj_context_error(context), "No space left on device");
+    EXPECT_TRUE(filesIn(mount_).empty());
+    EXPECT_EQ(dqj_context_destroy(context), DQJ_OK);
+}
+
+TEST_F(Hostile, ATruncatedVdbIsRefusedWithAShortReason) {
+    ASSERT_EQ(run("bake -q -r 48 -o " + path("whole.vdb")).exitCode, 0);
+    const std::string whole = readFile(dir_ / "whole.vdb");
+    for (std::size_t size : {std::size_t(0), std::size_t(7), std::size_t(200), whole.size() / 3, whole.size() - 1}) {
+        write("cut.vdb", whole.substr(0, size));
+        const auto result = run("render -q -W 32 -H 24 --voxels " + path("cut.vdb") + " -o " + path("voxels.png"));
+        EXPECT_EQ(result.exitCode, 1) << size << ": " << result.err;
+        EXPECT_CONTAINS(result.err, "cannot read '");
+        EXPECT_LT(result.err.size(), 400u) << result.err;
+        EXPECT_FALSE(fs::exists(dir_ / "voxels.png"));
+    }
+    const auto result = run("render -q -W 32 -H 24 --voxels " + path("whole.vdb") + " -o " + path("voxels.png"));
+    EXPECT_EQ(result.exitCode, 0) << result.err;
+}
+
+// --- The JSON path: nesting, size, duplicates, NUL bytes ---------------------------------
+
+TEST_F(Hostile, DeepNestingIsRefusedNotAStackOverflow) {
+    write("deep.json", "{\"fractal\": {\"c\": " + std::string(100000, '[') + "}}");
+    const auto result = run("render -q -p " + path("deep.json") + " -o " + path("out.png"));
+    EXPECT_EQ(result.exitCode, 2) << result.err;
+    EXPECT_CONTAINS(result.err, "nested deeper than 64 levels");
+    EXPECT_FALSE(fs::exists(dir_ / "out.png"));
+}
+
+void* parseDeepOnSmallStack(void* status) {
+    dqj_context context = nullptr;
+    dqj_context_create(&context);
+    const std::string json = std::string(12000, '[') + std::string(12000, ']');
+    *static_cast<dqj_status*>(status) = dqj_context_set_params_json(context, json.c_str());
+    dqj_context_destroy(context);
+    return nullptr;
+}
+
+TEST(HostileC, DeepNestingOnA1MegabyteThreadStackReturnsAnError) {
+    pthread_attr_t attributes;
+    pthread_attr_init(&attributes);
+    pthread_attr_setstacksize(&attributes, 1 << 20);  // as in Blender's worker threads
+    dqj_status status = DQJ_OK;
+    pthread_t thread;
+    ASSERT_EQ(pthread_create(&thread, &attributes, parseDeepOnSmallStack, &status), 0);
+    pthread_join(thread, nullptr);
+    pthread_attr_destroy(&attributes);
+    EXPECT_EQ(status, DQJ_ERROR_PARAMETERS);
+}
+
+TEST_F(Hostile, ANeverEndingParameterFileIsCutAtTheSizeLimit) {
+    const auto result = run("render -q -p /dev/zero -o " + path("out.png"));
+    EXPECT_EQ(result.exitCode, 2) << result.err;
+    EXPECT_CONTAINS(result.err, "larger than 16 MiB");
+    EXPECT_FALSE(fs::exists(dir_ / "out.png"));
+}
+
+TEST_F(Hostile, DuplicateKeysAreRejectedByName) {
+    write("dup.json", R"({"fractal": {"iterations": 8}, "fractal": {"bailout": 5}})");
+    auto result = run("render -q -p " + path("dup.json") + " -o " + path("out.png"));
+    EXPECT_EQ(result.exitCode, 2) << result.err;
+    EXPECT_CONTAINS(result.err, "fractal: duplicate key \"fractal\"");
+    write("dup.json", R"({"render": {"width": 8, "height": 8, "width": 9}})");
+    result = run("render -q -p " + path("dup.json") + " -o " + path("out.png"));
+    EXPECT_EQ(result.exitCode, 2) << result.err;
+    EXPECT_CONTAINS(result.err, "render.width: duplicate key \"width\"");
+    EXPECT_FALSE(fs::exists(dir_ / "out.png"));
+}
+
+TEST_F(Hostile, MessagesKeepWhatFollowsANulByte) {
+    write("nul.json", R"({"fractal": {"variant": "pa\u0000per-coupled"}})");
+    const auto result = run("render -q -p " + path("nul.json") + " -o " + path("out.png"));
+    EXPECT_EQ(result.exitCode, 2) << result.err;
+    EXPECT_CONTAINS(result.err, "per-coupled\"");
+    EXPECT_EQ(result.err.find('\0'), std::string::npos);
+}
+
+TEST_F(Hostile, AnInterruptedReadOfTheParameterFileExits130) {
+    ASSERT_EQ(::mkfifo((dir_ / "params.json").c_str(), 0600), 0);  // no writer: the open blocks
+    const pid_t pid = dqj::test::spawnProgram(DQJ_CLI, {"render", "-q", "-p", (dir_ / "params.json").string(), "-o",
+                                                        (dir_ / "out.png").string()},
+                                              dir_ / "stderr.txt");
+    ASSERT_GT(pid, 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(700));
+    ASSERT_EQ(::kill(pid, SIGINT), 0);
+    EXPECT_EQ(waitExit(pid), 130) << readFile(dir_ / "stderr.txt");
+    EXPECT_CONTAINS(readFile(dir_ / "stderr.txt"), "interrupted");
+    EXPECT_FALSE(fs::exists(dir_ / "out.png"));
+}
+
+// --- Values accepted in silence ----------------------------------------------------------
+
+TEST_F(Hostile, LinearlyDependentSliceAxesAreRejected) {
+    write("axes.json", R"({"slice": {"axes": [[1,0,0,0,0,0,0,0], [0,1,0,0,0,0,0,0], [1,1,0,0,0,0,0,0]]}})");
+    const auto result = run("render -q -p " + path("axes.json") + " -o " + path("out.png"));
+    EXPECT_EQ(result.exitCode, 2) << result.err;
+    EXPECT_CONTAINS(result.err, "slice.axes: the three axes are linearly dependent");
+    EXPECT_FALSE(fs::exists(dir_ / "out.png"));
+}
+
+TEST_F(Hostile, ANonFiniteCameraIsRejectedAndNotSaved) {
+    const auto result = run("render -q -W 8 -H 8 --camera-position inf 0 0 -o " + path("out.png") + " --save-params " +
+                            path("saved.json"));
+    EXPECT_EQ(result.exitCode, 2) << result.err;
+    EXPECT_CONTAINS(result.err, "camera.position: must be 3 finite numbers");
+    EXPECT_TRUE(filesIn(dir_).empty());
+    const auto far = run("render -q -W 8 -H 8 --camera-target 1e300 0 0 -o " + path("out.png"));
+    EXPECT_EQ(far.exitCode, 2) << far.err;
+    EXPECT_CONTAINS(far.err, "camera.target: must be 3 finite numbers from -1e9 to 1e9");
+    EXPECT_TRUE(filesIn(dir_).empty());
+}
+
+TEST_F(Hostile, WhatFlagsSetIsCheckedWithTheFileFormatsRanges) {
+    // A flag may not set what --save-params would write as a file that does not read back.
+    for (const std::string flags : {"--bailout 1e200", "--c 1000 0 0 0 0 0 0 0", "--detail 5000", "--max-steps 2000000",
+                                    "--rotate a.j,b.s:1e9", "--camera-position 1e10 0 0"}) {
+        const auto result = run("render -q -W 8 -H 8 " + flags + " -o " + path("out.png") + " --save-params " + path("p.json"));
+        EXPECT_EQ(result.exitCode, 2) << flags << ": " << result.err;
+        EXPECT_CONTAINS(result.err, "must be");
+        EXPECT_TRUE(filesIn(dir_).empty()) << flags;
+    }
+}
+
+// --- Outputs: empty names, one file twice, no-clobber, non-regular files -----------------
+
+TEST_F(Hostile, AnEmptyOutputNameIsRejected) {
+    const auto result = run("render -q -W 8 -H 8 -o ''");
+    EXPECT_EQ(result.exitCode, 2) << result.err;
+    EXPECT_CONTAINS(result.err, "--output is empty");
+    EXPECT_TRUE(filesIn(dir_).empty());
+}
+
+TEST_F(Hostile, SaveParamsOntoTheImageIsRejected) {
+    const auto result = run("render -q -W 8 -H 8 -o " + path("same.png") + " --save-params " + path("./same.png"));
+    EXPECT_EQ(result.exitCode, 2) << result.err;
+    EXPECT_CONTAINS(result.err, "--output and --save-params both name");
+    EXPECT_TRUE(filesIn(dir_).empty());
+}
+
+TEST_F(Hostile, AFileThatAppearsDuringTheWorkIsNotReplacedWithoutForce) {
+    const fs::path output = dir_ / "race.png";
+    const pid_t pid = dqj::test::spawnProgram(DQJ_CLI, {"render", "-q", "-W", "800", "-H", "600", "-s", "2", "-o", output.string()},
+                                              dir_ / "stderr.txt");
+    ASSERT_GT(pid, 0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    std::ofstream(output) << "the other run's picture";  // another run finished first
+    EXPECT_EQ(waitExit(pid), 1) << readFile(dir_ / "stderr.txt");
+    EXPECT_CONTAINS(readFile(dir_ / "stderr.txt"), "and is kept (pass --force to overwrite it)");
+    EXPECT_EQ(readFile(output), "the other run's picture");
+    EXPECT_FALSE(hasTemporary(filesIn(dir_)));
+}
+
+TEST_F(Hostile, OutputsThatAreNotRegularFilesAreRefusedBeforeTheWork) {
+    ASSERT_EQ(::mkfifo((dir_ / "pipe.png").c_str(), 0600), 0);
+    auto result = run("render -q -W 8 -H 8 --force -o " + path("pipe.png"));
+    EXPECT_EQ(result.exitCode, 2) << result.err;
+    EXPECT_CONTAINS(result.err, "not a regular file");
+    struct stat info {};
+    ASSERT_EQ(::lstat((dir_ / "pipe.png").c_str(), &info), 0);
+    EXPECT_TRUE(S_ISFIFO(info.st_mode));
+    // A special file system where no file can be created: refused before the work, not after.
+    result = run("bake -q -r 8 -o /proc/dqjulia-test.vdb");
+    EXPECT_EQ(result.exitCode, 2) << result.err;
+    EXPECT_CONTAINS(result.err, "cannot write '/proc/dqjulia-test.vdb'");
+}
+
+// --- POV-Ray: names a scene string cannot carry, settings the include must refuse --------
+
+TEST_F(Hostile, Df3SceneNamesPovrayCannotCarryAreRefused) {
+    for (const std::string name : {"caf\xc3\xa9", "quote\"d", "back\\slash"}) {
+        const auto result = run("povray -q --df3 --df3-resolution 8 -o '" + (dir_ / (name + ".pov")).string() + "'");
+        EXPECT_EQ(result.exitCode, 2) << name << ": " << result.err;
+        EXPECT_CONTAINS(result.err, "carries only printable ASCII");
+        EXPECT_TRUE(filesIn(dir_).empty());
+    }
+    EXPECT_EQ(run("povray -q --df3 --df3-resolution 8 -o " + path("plain name.pov")).exitCode, 0);
+}
+
+TEST_F(Hostile, ThePovrayIncludeStopsOnInvalidSettings) {
+    if (std::system("command -v povray > /dev/null 2>&1") != 0) GTEST_SKIP() << "povray is not installed";
+    ASSERT_EQ(run("povray -q -o " + path("scene.pov")).exitCode, 0);  // writes dqjulia.inc beside it
+    struct Case {
+        const char* slice;
+        const char* bailout;
+        const char* threshold;
+        const char* message;
+    };
+    const Case cases[] = {
+        {"DQJ_Slice_Names(\"a.s,a.i,a.j\")", "1e999", "0.01", "the bailout R must be a finite number"},
+        {"array[4][8] {{0,0,0,0,0,0,0,0},{1,0,0,0,0,0,0,0},{0,1,0,0,0,0,0,0},{1,1,0,0,0,0,0,0}}", "4", "0.01",
+         "zero, parallel or linearly dependent"},
+        {"DQJ_Slice_Names(\"a.s,a.i,a.j\")", "4", "-0.01", "threshold must be 0 or more"},
+    };
+    for (const Case& test : cases) {
+        write("bad.pov", std::string("#version 3.7;\n#include \"dqjulia.inc\"\n") +
+                             "#declare C = array[8] {-0.39054, -0.58679, 0, 0, 0, 0.5632, 0, 0.05};\n#declare S = " +
+                             test.slice + ";\ncamera { location <0, 0, -4> look_at 0 }\nobject { DQJ_Isosurface(C, \"paper\", 6, " +
+                             test.bailout + ", S, " + test.threshold + ") pigment { rgb 1 } }\n");
+        const std::string command = "cd '" + dir_.string() + "' && povray +W8 +H6 -D +Ibad.pov +Obad.png > povray.txt 2>&1";
+        EXPECT_NE(std::system(command.c_str()), 0) << test.message;
+        EXPECT_CONTAINS(readFile(dir_ / "povray.txt"), test.message);
+        EXPECT_FALSE(fs::exists(dir_ / "bad.png"));
+    }
+}
+
+// --- Signals and crashes -----------------------------------------------------------------
+
+TEST_F(Hostile, SighupStopsABakeLikeSigtermAndSigkillLeavesNoTemporaryFile) {
+    const fs::path output = dir_ / "fractal.vdb";
+    for (int signal : {SIGHUP, SIGKILL}) {
+        std::ofstream(output) << "previous bake";
+        const pid_t pid = dqj::test::spawnProgram(DQJ_CLI, {"bake", "-q", "--force", "-r", "512", "-o", output.string()},
+                                                  dir_ / "stderr.txt");
+        ASSERT_GT(pid, 0);
+        std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+        ASSERT_EQ(::kill(pid, signal), 0);
+        const int exitCode = waitExit(pid);
+        if (signal == SIGHUP) {
+            EXPECT_EQ(exitCode, 130) << readFile(dir_ / "stderr.txt");
+            EXPECT_CONTAINS(readFile(dir_ / "stderr.txt"), "interrupted");
+        } else {
+            EXPECT_EQ(exitCode, 128 + SIGKILL);
+        }
+        EXPECT_EQ(readFile(output), "previous bake");
+        EXPECT_EQ(filesIn(dir_), (std::set<std::string>{"fractal.vdb", "stderr.txt"}));
+    }
+}
+
+TEST_F(Hostile, AStaleHiddenTemporaryIsRemovedByTheNextRun) {
+    // What a writer killed on a file system without O_TMPFILE leaves (or one killed between
+    // linking and renaming): nobody holds its lock, so the next write into the folder removes it.
+    write(".out.png.tmp-AbC123", "left by a crash");
+    const auto minuteAgo = fs::last_write_time(dir_ / ".out.png.tmp-AbC123") - std::chrono::minutes(1);
+    fs::last_write_time(dir_ / ".out.png.tmp-AbC123", minuteAgo);  // not one being written right now
+    const auto result = run("render -q -W 8 -H 8 -o " + path("out.png"));
+    EXPECT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_EQ(filesIn(dir_), std::set<std::string>{"out.png"});
+}
+
+// --- Memory --------------------------------------------------------------------------------
+
+TEST_F(Hostile, TheBakeMemoryGuardRespectsTheProcessLimit) {
+#if DQJ_SANITIZED
+    GTEST_SKIP() << "AddressSanitizer cannot run under a virtual memory limit";
+#else
+    const auto start = std::chrono::steady_clock::now();
+    // An explicit --max-memory far above the cap: only the process limit can refuse it in time.
+    const std::string command = "ulimit -v 1200000; '" + std::string(DQJ_CLI) + "' bake -q -r 4096 --max-memory 100G -o " + path("big.vdb") +
+                                " 2> " + path("err.txt");
+    const int status = std::system(command.c_str());
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    EXPECT_EQ(WEXITSTATUS(status), 2) << readFile(dir_ / "err.txt");
+    EXPECT_CONTAINS(readFile(dir_ / "err.txt"), "under its memory limits");
+    EXPECT_LT(seconds, 60.0);
+    EXPECT_FALSE(fs::exists(dir_ / "big.vdb"));
+#endif
+}
+
+// --- The C ABI misused ---------------------------------------------------------------------
+
+struct DestroyAttempt {
+    dqj_context context;
+    dqj_status status = DQJ_OK;
+    bool tried = false;
+};
+
+int destroyFromCallback(double, void* data) {
+    auto* attempt = static_cast<DestroyAttempt*>(data);
+    if (!attempt->tried) {
+        attempt->tried = true;
+        attempt->status = dqj_context_destroy(attempt->context);
+    }
+    return 0;
+}
+
+TEST(HostileC, DestroyingAContextFromItsOwnCallbackIsRefused) {
+    const fs::path folder = dqj::test::freshTestFolder("dqjulia_hostile_c");
+    for (int call = 0; call < 3; ++call) {
+        dqj_context context = nullptr;
+        ASSERT_EQ(dqj_context_create(&context), DQJ_OK);
+        ASSERT_EQ(dqj_context_set_bake_resolution(context, 24), DQJ_OK);
+        DestroyAttempt attempt{context};
+        const std::string vdb = (folder / "bake.vdb").string();
+        std::vector<std::uint8_t> pixels(16 * 16 * 4);
+        const dqj_status status = call == 0   ? dqj_mesh_compute(context, destroyFromCallback, &attempt)
+                                  : call == 1 ? dqj_bake_vdb(context, vdb.c_str(), destroyFromCallback, &attempt)
+                                              : dqj_render_rgba8(context, pixels.data(), 16, 16, 64, destroyFromCallback, &attempt);
+        EXPECT_TRUE(attempt.tried);
+        EXPECT_EQ(attempt.status, DQJ_ERROR_BUSY) << call;
+        EXPECT_EQ(status, DQJ_OK) << dqj_context_error(context);
+        // A nested call on the busy context is refused the same way.
+        EXPECT_EQ(dqj_context_destroy(context), DQJ_OK);
+        EXPECT_EQ(dqj_context_destroy(context), DQJ_ERROR_INVALID_HANDLE);
+    }
+    fs::remove_all(folder);
+}
+
+int nestedCall(double, void* data) {
+    auto* attempt = static_cast<DestroyAttempt*>(data);
+    if (!attempt->tried) {
+        attempt->tried = true;
+        attempt->status = dqj_context_set_iterations(attempt->context, 9);
+    }
+    return 0;
+}
+
+TEST(HostileC, ACallOnABusyContextIsRefused) {
+    dqj_context context = nullptr;
+    ASSERT_EQ(dqj_context_create(&context), DQJ_OK);
+    DestroyAttempt attempt{context};
+    std::vector<std::uint8_t> pixels(16 * 16 * 4);
+    EXPECT_EQ(dqj_render_rgba8(context, pixels.data(), 16, 16, 64, nestedCall, &attempt), DQJ_OK);
+    EXPECT_EQ(attempt.status, DQJ_ERROR_BUSY);
+    EXPECT_EQ(dqj_context_destroy(context), DQJ_OK);
+}
+
+TEST(HostileC, AStaleHandleNeverNamesANewContext) {
+    std::set<dqj_context> seen;
+    for (int round = 0; round < 100; ++round) {
+        dqj_context old = nullptr, fresh = nullptr;
+        ASSERT_EQ(dqj_context_create(&old), DQJ_OK);
+        ASSERT_EQ(dqj_context_destroy(old), DQJ_OK);
+        ASSERT_EQ(dqj_context_create(&fresh), DQJ_OK);  // may get the old context's memory
+        EXPECT_NE(fresh, old);
+        EXPECT_TRUE(seen.insert(old).second);
+        EXPECT_EQ(dqj_context_set_iterations(old, 7), DQJ_ERROR_INVALID_HANDLE);
+        EXPECT_STREQ(dqj_context_error(old), "invalid dqjulia context (null, unknown or already destroyed)");
+        std::vector<char> json(1 << 16);
+        ASSERT_EQ(dqj_context_get_params_json(fresh, json.data(), json.size(), nullptr), DQJ_OK);
+        EXPECT_EQ(std::string(json.data()).find("\"iterations\": 7"), std::string::npos);
+        EXPECT_EQ(dqj_context_destroy(fresh), DQJ_OK);
+    }
+}
+
+// --- Fault injection: short writes, ENOSPC, failing fsync and close in every writer ------
+
+struct Writer {
+    const char* name;
+    const char* arguments;  // OUT is the fault folder
+    std::vector<const char*> outputs;
+};
+
+const Writer kWriters[] = {
+    {"png", "render -q -W 48 -H 32 -o OUT/out.png", {"out.png"}},
+    {"png16", "render -q -W 48 -H 32 --format png16 -o OUT/out.png", {"out.png"}},
+    {"exr", "render -q -W 48 -H 32 -o OUT/out.exr", {"out.exr"}},
+    {"params", "render -q -W 8 -H 8 -o OK/image.png --save-params OUT/out.json", {"out.json"}},
+    {"vdb", "bake -q -r 32 --grids surface,density,color -o OUT/out.vdb", {"out.vdb"}},
+    {"ply", "mesh -q -r 32 -o OUT/out.ply", {"out.ply"}},
+    {"obj", "mesh -q -r 32 -o OUT/out.obj", {"out.obj"}},
+    {"pov", "povray -q -o OUT/out.pov", {"out.pov", "dqjulia.inc"}},
+    {"df3", "povray -q --no-include --df3 --df3-resolution 12 -o OUT/out.pov", {"out.pov", "out.df3", "out_df3.pov"}},
+};
+
+class FaultInjection : public Hostile, public ::testing::WithParamInterface<Writer> {
+protected:
+    bool noTmpfile_ = false;  // the writer's fallback for file systems without O_TMPFILE
+    dqj::test::CommandResult runWith(const std::string& mode, long long after) {
+        std::string arguments = GetParam().arguments;
+        const std::string out = (dir_ / "faulty").string(), ok = (dir_ / "ok").string();
+        arguments.replace(arguments.find("OUT"), 3, out);
+        if (arguments.find("OK") != std::string::npos) arguments.replace(arguments.find("OK"), 2, ok);
+        const std::string environment = "env LD_PRELOAD='" + std::string(DQJ_FAULT_SHIM) + "' DQJ_FAULT_DIR='" + out +
+                                        "' DQJ_FAULT_MODE=" + mode + " DQJ_FAULT_AFTER=" + std::to_string(after) +
+                                        " DQJ_FAULT_NO_TMPFILE=" + (noTmpfile_ ? "1" : "0") +
+                                        " ASAN_OPTIONS=verify_asan_link_order=0:detect_leaks=0 '" + DQJ_CLI + "' ";
+        return dqj::test::runCommand("/bin/sh", "-c \"" + environment + arguments + " --force\"", dir_);
+    }
+};
+
+TEST_P(FaultInjection, EveryFailureIsReportedAndLeavesTheOldFiles) {
+    const fs::path faulty = dir_ / "faulty";
+    fs::create_directories(faulty);
+    fs::create_directories(dir_ / "ok");
+    auto resetOld = [&] {
+        for (const auto& entry : fs::directory_iterator(faulty)) fs::remove(entry.path());
+        for (const char* name : GetParam().outputs) std::ofstream(faulty / name) << "old " << name;
+    };
+    // A clean run (through the shim, faults off) gives the total bytes written.
+    resetOld();
+    auto clean = runWith("none", 0);
+    ASSERT_EQ(clean.exitCode, 0) << clean.err;
+    std::uintmax_t total = 0;
+    std::map<std::string, std::uintmax_t> sizes;
+    for (const char* name : GetParam().outputs) total += sizes[name] = fs::file_size(faulty / name);
+    ASSERT_GT(total, 2u);
+
+    struct Point {
+        std::string mode;
+        long long after;
+        const char* reason;
+    };
+    const long long all = static_cast<long long>(total);
+    const std::vector<Point> points{{"enospc", 0, "No space left on device"},        {"enospc", 1, "No space left on device"},
+                                    {"enospc", all / 2, "No space left on device"},  {"enospc", all - 1, "No space left on device"},
+                                    {"short", all / 3, "No space left on device"},   {"short", all - 1, "No space left on device"},
+                                    {"fsync", 0, "Input/output error"},             {"close", 0, "Input/output error"}};
+    for (const bool noTmpfile : {false, true})
+    for (const Point& point : points) {
+        noTmpfile_ = noTmpfile;
+        SCOPED_TRACE(point.mode + " after " + std::to_string(point.after) + " bytes" + (noTmpfile ? ", without O_TMPFILE" : ""));
+        resetOld();
+        const auto result = runWith(point.mode, point.after);
+        EXPECT_EQ(result.exitCode, 1) << result.err;
+        EXPECT_CONTAINS(result.err, point.reason);
+        EXPECT_CONTAINS(result.err, "cannot write '" + faulty.string() + "/");
+        const std::set<std::string> left = filesIn(faulty);
+        EXPECT_FALSE(hasTemporary(left));
+        // Each output is either its old content or complete (a multi-file writer publishes
+        // its files one by one); the file the fault hit, and every later one, stays old.
+        long long before = 0;
+        for (const char* name : GetParam().outputs) {
+            const std::string content = readFile(faulty / name);
+            const bool hit = point.mode == "fsync" || point.mode == "close" || point.after < before + (long long)sizes[name];
+            if (hit || before > point.after) EXPECT_EQ(content, std::string("old ") + name) << name;
+            else EXPECT_EQ(content.size(), sizes[name]) << name;
+            before += (long long)sizes[name];
+        }
+    }
+    // Short writes alone (no space problem) must still give complete files, with and without
+    // O_TMPFILE, and leave no hidden file.
+    for (const bool noTmpfile : {false, true}) {
+        noTmpfile_ = noTmpfile;
+        resetOld();
+        const auto shortOnly = runWith("short", 1LL << 40);
+        EXPECT_EQ(shortOnly.exitCode, 0) << shortOnly.err;
+        for (const char* name : GetParam().outputs) EXPECT_EQ(fs::file_size(faulty / name), sizes[name]) << name;
+        EXPECT_FALSE(hasTemporary(filesIn(faulty)));
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Writers, FaultInjection, ::testing::ValuesIn(kWriters),
+                         [](const auto& info) { return std::string(info.param.name); });
+
+}  // namespace
