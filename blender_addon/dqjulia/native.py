@@ -39,6 +39,7 @@ ERROR_IO = 4
 ERROR_CANCELLED = 5
 ERROR_OUT_OF_MEMORY = 6
 ERROR_INTERNAL = 7
+ERROR_BUSY = 8  # a call on the context is running (e.g. destroy from its own progress callback)
 
 VARIANTS = ("paper", "paper-coupled", "dual")  # dqj_variant order
 
@@ -98,7 +99,7 @@ _SIGNATURES = {
     "dqj_version_string": (ctypes.c_char_p, [], True),
     "dqj_status_string": (ctypes.c_char_p, [ctypes.c_int], True),
     "dqj_context_create": (_status, [ctypes.POINTER(_handle)], True),
-    "dqj_context_destroy": (None, [_handle], True),
+    "dqj_context_destroy": (_status, [_handle], True),
     "dqj_context_error": (ctypes.c_char_p, [_handle], True),
     "dqj_context_warning": (ctypes.c_char_p, [_handle], True),
     "dqj_context_load_params_file": (_status, [_handle, ctypes.c_char_p], True),
@@ -302,8 +303,12 @@ class Context:
             self.set_params(params)
 
     def close(self):
+        """Destroys the native context. Raises NativeError (ERROR_BUSY) if one of its calls is
+        still running, e.g. when called from that call's progress callback: cancel instead."""
         if getattr(self, "_handle", None):
-            self._lib.dqj_context_destroy(self._handle)
+            status = self._lib.dqj_context_destroy(self._handle)
+            if status == ERROR_BUSY:
+                raise NativeError(status, "the dqjulia context is busy (a call on it is running): cancel it first")
             self._handle = None
 
     def __del__(self):
