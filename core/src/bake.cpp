@@ -1,5 +1,6 @@
 // Baking to OpenVDB (bake.hpp): the level set, the fog volume, the attribute grids and the file.
 #include "dqjulia/bake.hpp"
+#include "dqjulia/version.h"
 #include "dqjulia/batch.hpp"
 
 #include <algorithm>
@@ -283,7 +284,7 @@ BakeStats bakeVdb(const Params& params, const std::string& path, const BakeOptio
     staged.stage(BakeStage::Writing, 0.95, 1.0);
     if (progress && !progress(0.95)) throw Cancelled();
     openvdb::MetaMap metadata;
-    metadata.insertMeta("creator", openvdb::StringMetadata(std::string("dqjulia ") + DQJ_VERSION_STRING_FROM_BUILD));
+    metadata.insertMeta("creator", openvdb::StringMetadata(std::string("dqjulia ") + DQJ_VERSION_STRING));
     metadata.insertMeta("dqjulia_parameters", openvdb::StringMetadata(toJson(params)));
     metadata.insertMeta("dqjulia_voxel_size", openvdb::DoubleMetadata(stats.voxelSize));
     try {

@@ -215,7 +215,7 @@ void noteEmptyRender(dqj_context_t& context, const dqj::RenderResult& result) {
 extern "C" {
 
 unsigned dqj_version_number(void) { return DQJ_VERSION_NUMBER; }
-const char* dqj_version_string(void) { return DQJ_VERSION_STRING_FROM_BUILD; }
+const char* dqj_version_string(void) { return DQJ_VERSION_STRING; }
 
 const char* dqj_status_string(dqj_status status) {
     switch (status) {

@@ -1,5 +1,6 @@
 // Meshes of the baked surface (mesh.hpp): volumeToMesh, clean-up, normals, colours, PLY and OBJ.
 #include "dqjulia/mesh.hpp"
+#include "dqjulia/version.h"
 
 #include <algorithm>
 #include <bit>
@@ -109,7 +110,7 @@ std::vector<glm::vec3> vertexNormals(const Mesh& mesh) {
 void writePly(const Mesh& mesh, std::ostream& out) {
     static_assert(std::endian::native == std::endian::little, "the PLY writer assumes a little-endian machine");
     const bool colors = !mesh.colors.empty();
-    out << "ply\nformat binary_little_endian 1.0\ncomment dqjulia " << DQJ_VERSION_STRING_FROM_BUILD << "\n"
+    out << "ply\nformat binary_little_endian 1.0\ncomment dqjulia " << DQJ_VERSION_STRING << "\n"
         << "element vertex " << mesh.positions.size() << "\n"
         << "property float x\nproperty float y\nproperty float z\n"
         << "property float nx\nproperty float ny\nproperty float nz\n";
@@ -149,7 +150,7 @@ void writePly(const Mesh& mesh, std::ostream& out) {
 
 void writeObj(const Mesh& mesh, std::ostream& out) {
     const bool colors = !mesh.colors.empty();
-    out << "# dqjulia " << DQJ_VERSION_STRING_FROM_BUILD << ": " << mesh.positions.size() << " vertices, "
+    out << "# dqjulia " << DQJ_VERSION_STRING << ": " << mesh.positions.size() << " vertices, "
         << mesh.triangles.size() + mesh.quads.size() << " faces" << (colors ? "; vertex colours (sRGB) after x y z" : "")
         << "\n";
     char line[160];

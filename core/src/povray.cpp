@@ -2,6 +2,7 @@
 // bounds, camera frame, hit threshold, lights, Phong terms, colouring and background, with z
 // negated because POV-Ray is left-handed.
 #include "dqjulia/povray.hpp"
+#include "dqjulia/version.h"
 
 #include <algorithm>
 #include <cmath>
@@ -153,7 +154,7 @@ SceneFacts resolve(const Params& params) {
 
 void writeHeader(std::ostringstream& out, const Params& params, const PovraySceneOptions& options,
                  const std::string& kind) {
-    out << "// dqjulia scene for POV-Ray 3.7, written by `dqjulia povray` (dqjulia " << povString(DQJ_VERSION_STRING_FROM_BUILD)
+    out << "// dqjulia scene for POV-Ray 3.7, written by `dqjulia povray` (dqjulia " << povString(DQJ_VERSION_STRING)
         << ")" << (options.sourceName.empty() ? "" : " from " + povString(options.sourceName)) << ".\n";
     if (!params.description.empty()) out << commentBlock(params.description);
     out << "//\n" << commentBlock(kind);

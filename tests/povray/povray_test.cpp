@@ -22,6 +22,7 @@
 
 #include "dqjulia/image.hpp"
 #include "dqjulia/povray.hpp"
+#include "dqjulia/version.h"
 #include "dqjulia/render.hpp"
 #include "test_support.hpp"
 
