@@ -2,23 +2,16 @@
 #   cmake -DCLI=dqjulia -DBLENDER=blender -DSCRIPTS=tests/blender -DWORK=folder -DEXAMPLES=examples
 #         -DMODE=vdb|sequence|ply|obj -P blender_test.cmake
 #   ... -DPYTHON=VENV/bin/python -DBPY_VERSION=4.5.15 ...: check in a bpy wheel's venv instead
-#   (skipped, or failing when CI=true, if the venv is missing: run_blender.cmake's rule).
+#   (skipped, or failing when CI=true, if the venv is missing: tests/missing_tool.cmake's rule).
 # The dqjulia run uses small resolutions so the whole check takes seconds.
-if(PYTHON AND NOT EXISTS "${PYTHON}")
-  set(reason "the bpy ${BPY_VERSION} venv is missing (${PYTHON}): run scripts/bpy-env.sh ${BPY_VERSION}")
-  if("$ENV{CI}" STREQUAL "true")
-    message(FATAL_ERROR "${reason} (CI=true: the bpy tests must run)")
-  endif()
-  message("DQJ_TEST_SKIPPED: ${reason}")
+cmake_minimum_required(VERSION 3.25)
+include(${CMAKE_CURRENT_LIST_DIR}/blender_env.cmake)
+dqj_blender_venv_present(present)
+if(NOT present)
   return()
 endif()
 file(REMOVE_RECURSE "${WORK}")
-file(MAKE_DIRECTORY "${WORK}")
-foreach(kind RESOURCES CONFIG SCRIPTS DATAFILES EXTENSIONS)  # scratch user folders
-  string(TOLOWER "${kind}" folder)
-  file(MAKE_DIRECTORY "${WORK}/user/${folder}")
-  set(ENV{BLENDER_USER_${kind}} "${WORK}/user/${folder}")
-endforeach()
+dqj_blender_user_folders("${WORK}/user")
 
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE status OUTPUT_VARIABLE out ERROR_VARIABLE err)
