@@ -463,7 +463,8 @@ protected:
         const std::string environment = "env LD_PRELOAD='" + std::string(DQJ_FAULT_SHIM) + "' DQJ_FAULT_DIR='" + out +
                                         "' DQJ_FAULT_MODE=" + mode + " DQJ_FAULT_AFTER=" + std::to_string(after) +
                                         " DQJ_FAULT_NO_TMPFILE=" + (noTmpfile_ ? "1" : "0") +
-                                        " ASAN_OPTIONS=verify_asan_link_order=0:detect_leaks=0 '" + DQJ_CLI + "' ";
+                                        " ASAN_OPTIONS=verify_asan_link_order=0:detect_leaks=0:exitcode=86 UBSAN_OPTIONS=exitcode=86 '" +
+                                        DQJ_CLI + "' ";  // a sanitizer report is never taken for exit 1
         return dqj::test::runCommand("/bin/sh", "-c \"" + environment + arguments + " --force\"", dir_);
     }
 };
