@@ -219,6 +219,11 @@ TEST_F(Hostile, WhatFlagsSetIsCheckedWithTheFileFormatsRanges) {
         EXPECT_CONTAINS(result.err, "must be");
         EXPECT_TRUE(filesIn(dir_).empty()) << flags;
     }
+    // A message never contradicts its check: 170 is refused, so the range says "less than 170".
+    write("fov.json", R"({"camera": {"fov": 170}})");
+    const auto result = run("render -q -p " + path("fov.json") + " -o " + path("out.png"));
+    EXPECT_EQ(result.exitCode, 2) << result.err;
+    EXPECT_CONTAINS(result.err, "camera.fov: must be greater than 0 and less than 170, got 170");
 }
 
 // --- Outputs: empty names, one file twice, no-clobber, non-regular files -----------------
