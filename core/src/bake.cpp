@@ -48,7 +48,7 @@ private:
 /// Archive's seekable stream writer is what io::File::write calls, so the bytes are the same.
 class CheckedVdbWriter : public openvdb::io::Archive {
 public:
-    void write(std::ostream& out, const openvdb::GridPtrVec& grids, const openvdb::MetaMap& metadata) const {
+    void writeTo(std::ostream& out, const openvdb::GridPtrVec& grids, const openvdb::MetaMap& metadata) const {
         openvdb::io::Archive::write(out, grids, /*seekable=*/true, metadata);
     }
 };
@@ -288,7 +288,7 @@ BakeStats bakeVdb(const Params& params, const std::string& path, const BakeOptio
     metadata.insertMeta("dqjulia_parameters", openvdb::StringMetadata(toJson(params)));
     metadata.insertMeta("dqjulia_voxel_size", openvdb::DoubleMetadata(stats.voxelSize));
     try {
-        CheckedVdbWriter().write(file.stream(), grids, metadata);
+        CheckedVdbWriter().writeTo(file.stream(), grids, metadata);
     } catch (const openvdb::Exception& error) {
         if (!file.stream()) file.commit();  // throws with the write's reason ("No space left on device")
         throw std::runtime_error(AtomicFile::failureMessage(path, error.what()));

@@ -164,18 +164,20 @@ public:
         return it == node_.end() ? nullptr : &*it;
     }
 
-    double number(const Json& value, const std::string& key, double low, double high, bool lowOpen = false) const {
+    double number(const Json& value, const std::string& key, double low, double high, bool lowOpen = false,
+                  bool highOpen = false) const {
         if (!value.is_number()) fail(key, "must be a number, got " + describe(value));
         const double x = value.get<double>();
         if (!std::isfinite(x)) fail(key, "must be a finite number");
-        if (x < low || x > high || (lowOpen && x == low))
+        if (x < low || x > high || (lowOpen && x == low) || (highOpen && x == high))
             fail(key, "must be " + std::string(lowOpen ? "greater than " : "at least ") + formatNumber(low) +
-                          " and at most " + formatNumber(high) + ", got " + formatNumber(x));
+                          (highOpen ? " and less than " : " and at most ") + formatNumber(high) + ", got " + formatNumber(x));
         return x;
     }
 
-    void readNumber(const std::string& key, double& out, double low, double high, bool lowOpen = false) {
-        if (const Json* value = find(key)) out = number(*value, keyPath(key), low, high, lowOpen);
+    void readNumber(const std::string& key, double& out, double low, double high, bool lowOpen = false,
+                    bool highOpen = false) {
+        if (const Json* value = find(key)) out = number(*value, keyPath(key), low, high, lowOpen, highOpen);
     }
 
     void readInteger(const std::string& key, int& out, int low, int high) {
@@ -360,7 +362,7 @@ void readCamera(ObjectReader reader, Camera& camera) {
     if (const Json* value = reader.find("target")) camera.target = reader.vec3(*value, reader.keyPath("target"));
     reader.readVec3("direction", camera.direction);
     reader.readVec3("up", camera.up);
-    reader.readNumber("fov", camera.fovDegrees, 0.0, 170.0, true);
+    reader.readNumber("fov", camera.fovDegrees, 0.0, 170.0, true, true);  // as validate(): (0, 170)
     reader.finish();
 }
 

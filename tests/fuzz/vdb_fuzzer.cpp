@@ -7,9 +7,35 @@
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
+#include <new>
 #include <string>
 
 #include "dqjulia/voxel_render.hpp"
+
+// OpenVDB sizes some buffers from the file (a damaged compressed chunk may claim petabytes).
+// Outside sanitizers such a request fails in malloc and operator new throws std::bad_alloc,
+// which readDensity reports; AddressSanitizer's operator new aborts instead. So this program
+// (only this fuzzer) has an operator new that fails as glibc's would for sizes no bake holds.
+namespace {
+constexpr std::size_t kLargestAllocation = std::size_t(1) << 31;
+void* allocate(std::size_t size) {
+    if (size > kLargestAllocation) throw std::bad_alloc();
+    if (void* memory = std::malloc(size ? size : 1)) return memory;
+    throw std::bad_alloc();
+}
+}  // namespace
+void* operator new(std::size_t size) { return allocate(size); }
+void* operator new[](std::size_t size) { return allocate(size); }
+void operator delete(void* memory) noexcept { std::free(memory); }
+void operator delete[](void* memory) noexcept { std::free(memory); }
+void operator delete(void* memory, std::size_t) noexcept { std::free(memory); }
+void operator delete[](void* memory, std::size_t) noexcept { std::free(memory); }
+void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
+    return size > kLargestAllocation ? nullptr : std::malloc(size ? size : 1);
+}
+void* operator new[](std::size_t size, const std::nothrow_t& tag) noexcept { return operator new(size, tag); }
+void operator delete(void* memory, const std::nothrow_t&) noexcept { std::free(memory); }
+void operator delete[](void* memory, const std::nothrow_t&) noexcept { std::free(memory); }
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     static const std::string path = [] {

@@ -219,6 +219,11 @@ TEST_F(Hostile, WhatFlagsSetIsCheckedWithTheFileFormatsRanges) {
         EXPECT_CONTAINS(result.err, "must be");
         EXPECT_TRUE(filesIn(dir_).empty()) << flags;
     }
+    // A message never contradicts its check: 170 is refused, so the range says "less than 170".
+    write("fov.json", R"({"camera": {"fov": 170}})");
+    const auto result = run("render -q -p " + path("fov.json") + " -o " + path("out.png"));
+    EXPECT_EQ(result.exitCode, 2) << result.err;
+    EXPECT_CONTAINS(result.err, "camera.fov: must be greater than 0 and less than 170, got 170");
 }
 
 // --- Outputs: empty names, one file twice, no-clobber, non-regular files -----------------
@@ -463,7 +468,8 @@ protected:
         const std::string environment = "env LD_PRELOAD='" + std::string(DQJ_FAULT_SHIM) + "' DQJ_FAULT_DIR='" + out +
                                         "' DQJ_FAULT_MODE=" + mode + " DQJ_FAULT_AFTER=" + std::to_string(after) +
                                         " DQJ_FAULT_NO_TMPFILE=" + (noTmpfile_ ? "1" : "0") +
-                                        " ASAN_OPTIONS=verify_asan_link_order=0:detect_leaks=0 '" + DQJ_CLI + "' ";
+                                        " ASAN_OPTIONS=verify_asan_link_order=0:detect_leaks=0:exitcode=86 UBSAN_OPTIONS=exitcode=86 '" +
+                                        DQJ_CLI + "' ";  // a sanitizer report is never taken for exit 1
         return dqj::test::runCommand("/bin/sh", "-c \"" + environment + arguments + " --force\"", dir_);
     }
 };
