@@ -10,7 +10,7 @@
 #include <new>
 #include <string>
 
-#include "dqjulia/voxel_render.hpp"
+#include "voxel_render.hpp"  // core/cli: the command's voxel renderer reads VDB files back
 
 // OpenVDB sizes some buffers from the file (a damaged compressed chunk may claim petabytes).
 // Outside sanitizers such a request fails in malloc and operator new throws std::bad_alloc,
