@@ -4,6 +4,6 @@
 # clone in another folder reuses it. It only saves time: without it everything builds anyway.
 DQJ_LAUNCHER=()
 if command -v ccache >/dev/null 2>&1; then
-  DQJ_LAUNCHER=(-DCMAKE_C_COMPILER_LAUNCHER=ccache -DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
-  export CCACHE_BASEDIR="$PWD" CCACHE_NOHASHDIR=1
+  launcher="env;CCACHE_BASEDIR=$PWD;CCACHE_NOHASHDIR=1;ccache"
+  DQJ_LAUNCHER=("-DCMAKE_C_COMPILER_LAUNCHER=$launcher" "-DCMAKE_CXX_COMPILER_LAUNCHER=$launcher")
 fi
