@@ -1,10 +1,11 @@
-// test_support.hpp - helpers the GoogleTest suites share: a scratch folder per test, reading a
-// file whole, running a command and capturing its output, and starting a program in the
+// test_support.hpp - helpers the GoogleTest suites share: a scratch folder per test, a small
+// tmpfs (a disk that fills up), reading a file whole, running a command and capturing its output, and starting a program in the
 // background (for the interrupt tests).
 #pragma once
 #include <fcntl.h>
 #include <gtest/gtest.h>
 #include <spawn.h>
+#include <sys/mount.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -32,6 +33,27 @@ inline std::filesystem::path freshTestFolder(const std::string& prefix) {
     std::filesystem::create_directories(folder);
     return folder;
 }
+
+/// A small tmpfs of `size` (e.g. "64k") mounted at `path` (created) while the object lives: a
+/// disk that fills up. mounted() is false where mounting is not allowed (not root): skip then.
+class Tmpfs {
+public:
+    Tmpfs(const std::filesystem::path& path, const std::string& size) : path_(path) {
+        std::filesystem::create_directories(path_);
+        mounted_ = ::mount("tmpfs", path_.c_str(), "tmpfs", 0, ("size=" + size).c_str()) == 0;
+    }
+    ~Tmpfs() {
+        if (mounted_) ::umount(path_.c_str());
+    }
+    Tmpfs(const Tmpfs&) = delete;
+    Tmpfs& operator=(const Tmpfs&) = delete;
+    bool mounted() const { return mounted_; }
+    const std::filesystem::path& path() const { return path_; }
+
+private:
+    std::filesystem::path path_;
+    bool mounted_ = false;
+};
 
 /// The whole file as bytes; "" if it cannot be read.
 inline std::string readFile(const std::filesystem::path& path) {

@@ -5,7 +5,6 @@
 
 #include <pthread.h>
 #include <signal.h>
-#include <sys/mount.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -16,6 +15,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <thread>
@@ -33,7 +33,7 @@ class Hostile : public ::testing::Test {
 protected:
     void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_hostile"); }
     void TearDown() override {
-        if (mounted_) ::umount(mount_.c_str());
+        disk_.reset();
         fs::remove_all(dir_);
     }
     dqj::test::CommandResult run(const std::string& arguments, const std::string& input = "") {
@@ -46,17 +46,16 @@ protected:
         return names;
     }
     void write(const std::string& name, const std::string& text) const { std::ofstream(dir_ / name, std::ios::binary) << text; }
-    /// A small tmpfs at dir_/name of `size` (e.g. "64k"); false if mounting is not allowed here.
+    /// A small tmpfs at dir_/name of `size` (e.g. "64k"), as mount_; false if mounting is not allowed here.
     bool mountTmpfs(const std::string& name, const std::string& size) {
         mount_ = dir_ / name;
-        fs::create_directories(mount_);
-        mounted_ = ::mount("tmpfs", mount_.c_str(), "tmpfs", 0, ("size=" + size).c_str()) == 0;
-        return mounted_;
+        disk_.emplace(mount_, size);
+        return disk_->mounted();
     }
 
     fs::path dir_;
     fs::path mount_;
-    bool mounted_ = false;
+    std::optional<dqj::test::Tmpfs> disk_;
 };
 
 #define EXPECT_CONTAINS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << "in: " << (text)

@@ -4,7 +4,6 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
-#include <sys/mount.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -30,10 +29,7 @@ namespace {
 class Scratch : public ::testing::Test {
 protected:
     void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_robust"); }
-    void TearDown() override {
-        if (mounted_) ::umount(dir_.c_str());
-        fs::remove_all(dir_);
-    }
+    void TearDown() override { fs::remove_all(dir_); }
     std::vector<std::string> filesIn(const fs::path& folder) const {
         std::vector<std::string> names;
         for (const auto& entry : fs::directory_iterator(folder)) names.push_back(entry.path().filename().string());
@@ -41,7 +37,6 @@ protected:
     }
 
     fs::path dir_;
-    bool mounted_ = false;
 };
 
 int waitExit(pid_t pid) {
@@ -76,11 +71,9 @@ INSTANTIATE_TEST_SUITE_P(Signals, Interrupt, ::testing::Values(SIGINT, SIGTERM),
                          [](const auto& info) { return info.param == SIGINT ? "SIGINT" : "SIGTERM"; });
 
 TEST_F(Scratch, FullDiskIsReportedAndLeavesNothing) {
-    const fs::path disk = dir_ / "tiny";
-    fs::create_directories(disk);
-    if (::mount("tmpfs", disk.c_str(), "tmpfs", 0, "size=32k") != 0)
-        GTEST_SKIP() << "cannot mount a small tmpfs here (" << std::strerror(errno) << "); needs root";
-    mounted_ = true;
+    const dqj::test::Tmpfs tiny(dir_ / "tiny", "32k");
+    if (!tiny.mounted()) GTEST_SKIP() << "cannot mount a small tmpfs here (" << std::strerror(errno) << "); needs root";
+    const fs::path& disk = tiny.path();
     const fs::path output = disk / "big.png";
     const pid_t pid = dqj::test::spawnProgram(DQJ_CLI, {"render", "-q", "-W", "640", "-H", "480", "-o", output.string()}, dir_ / "stderr.txt");
     ASSERT_GT(pid, 0);
@@ -88,8 +81,6 @@ TEST_F(Scratch, FullDiskIsReportedAndLeavesNothing) {
     const std::string err = readFile(dir_ / "stderr.txt");
     EXPECT_NE(err.find("No space left on device"), std::string::npos) << err;
     EXPECT_TRUE(filesIn(disk).empty()) << "left behind: " << (filesIn(disk).empty() ? "" : filesIn(disk).front());
-    ::umount(disk.c_str());
-    mounted_ = false;
 }
 
 // --- The C ABI from many threads -------------------------------------------------------
