@@ -47,12 +47,8 @@ log() { echo "dqjulia deps: $* ($(($(date +%s) - start)) s)" >&2; }
 # --- sources: Debian's source packages, through a private apt state (the system's is untouched).
 apt_dir="$work/apt"
 mkdir -p "$apt_dir/parts" "$apt_dir/lists/partial" "$apt_dir/cache/archives/partial" "$work/src"
-for sources in /etc/apt/sources.list.d/debian.sources /usr/share/doc/apt/examples/debian.sources; do
-  if [ -f "$sources" ]; then
-    sed 's/^Types:.*/Types: deb-src/' "$sources" > "$apt_dir/parts/debian.sources"
-    break
-  fi
-done
+sources=/etc/apt/sources.list.d/debian.sources
+[ -f "$sources" ] && sed 's/^Types:.*/Types: deb-src/' "$sources" > "$apt_dir/parts/debian.sources"
 if [ ! -s "$apt_dir/parts/debian.sources" ]; then
   echo "dqjulia deps: no Debian apt sources found (/etc/apt/sources.list.d/debian.sources)" >&2
   exit 1

@@ -1,18 +1,18 @@
 # Included by run_blender.cmake and blender_test.cmake: the environment of one Blender run.
-#   dqj_blender_venv_present()      with -DPYTHON (a bpy wheel's venv): FALSE, after skipping or
-#                                   failing by tests/missing_tool.cmake's rule, if the venv is missing
+#   dqj_blender_require_venv()      with -DPYTHON (a bpy wheel's venv) that is missing: skips or
+#                                   fails by tests/script_support.cmake's rule and ends the calling
+#                                   script (a macro, so its return() is the caller's)
 #   dqj_blender_user_folders(DIR)   fresh BLENDER_USER_RESOURCES (4.2+: every user folder), CONFIG,
 #                                   SCRIPTS, DATAFILES and EXTENSIONS (4.2+) under DIR, never the
 #                                   real user's folders
-include(${CMAKE_CURRENT_LIST_DIR}/../missing_tool.cmake)
+include(${CMAKE_CURRENT_LIST_DIR}/../script_support.cmake)
 
-function(dqj_blender_venv_present result)
-  set(${result} TRUE PARENT_SCOPE)
+macro(dqj_blender_require_venv)
   if(PYTHON AND NOT EXISTS "${PYTHON}")
     dqj_skip_or_fail("the bpy ${BPY_VERSION} venv is missing (${PYTHON}): run scripts/bpy-env.sh ${BPY_VERSION}")
-    set(${result} FALSE PARENT_SCOPE)
+    return()
   endif()
-endfunction()
+endmacro()
 
 function(dqj_blender_user_folders dir)
   file(REMOVE_RECURSE "${dir}")

@@ -9,10 +9,7 @@
 # (4.2+) all point into USER, never at the real user's folders.
 cmake_minimum_required(VERSION 3.25)
 include(${CMAKE_CURRENT_LIST_DIR}/blender_env.cmake)
-dqj_blender_venv_present(present)
-if(NOT present)
-  return()
-endif()
+dqj_blender_require_venv()
 dqj_blender_user_folders("${USER}")
 if(PYTHON)
   set(command "${PYTHON}" "${SCRIPT}" -- ${SCRIPT_ARGS})

@@ -2,25 +2,18 @@
 # twice, through find_package(dqjulia) and through pkg-config, and runs both programs.
 # -DBUILD=<build tree> -DSOURCE=<this folder> -DWORK=<scratch> -DCC=<C compiler>
 cmake_minimum_required(VERSION 3.25)
+include(${CMAKE_CURRENT_LIST_DIR}/../script_support.cmake)  # dqj_run
 file(REMOVE_RECURSE "${WORK}")
 set(prefix "${WORK}/prefix")
 
-function(run)
-  execute_process(COMMAND ${ARGN} RESULT_VARIABLE result OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT result EQUAL 0)
-    message(FATAL_ERROR "FAIL: ${ARGN}\n${out}${err}")
-  endif()
-  set(output "${out}" PARENT_SCOPE)
-endfunction()
-
 function(check_output what)
-  if(NOT output MATCHES "^dqjulia [0-9]+\\.[0-9]+\\.[0-9]+ n=[0-9]+ de=[0-9.]+")
-    message(FATAL_ERROR "FAIL: ${what} printed '${output}'")
+  if(NOT out MATCHES "^dqjulia [0-9]+\\.[0-9]+\\.[0-9]+ n=[0-9]+ de=[0-9.]+")
+    message(FATAL_ERROR "FAIL: ${what} printed '${out}'")
   endif()
-  message(STATUS "ok: ${what}: ${output}")
+  message(STATUS "ok: ${what}: ${out}")
 endfunction()
 
-run(${CMAKE_COMMAND} --install "${BUILD}" --prefix "${prefix}")
+dqj_run(${CMAKE_COMMAND} --install "${BUILD}" --prefix "${prefix}")
 foreach(file include/dqjulia/dqjulia.h lib/libdqjulia.so lib/cmake/dqjulia/dqjuliaConfig.cmake
              lib/cmake/dqjulia/dqjuliaConfigVersion.cmake lib/pkgconfig/dqjulia.pc)
   if(NOT EXISTS "${prefix}/${file}")
@@ -29,17 +22,17 @@ foreach(file include/dqjulia/dqjulia.h lib/libdqjulia.so lib/cmake/dqjulia/dqjul
 endforeach()
 
 # find_package(dqjulia)
-run(${CMAKE_COMMAND} -S "${SOURCE}" -B "${WORK}/cmake-build" "-DCMAKE_PREFIX_PATH=${prefix}" "-DCMAKE_C_COMPILER=${CC}")
-run(${CMAKE_COMMAND} --build "${WORK}/cmake-build")
-run(${CMAKE_COMMAND} -E env "LD_LIBRARY_PATH=${prefix}/lib" "${WORK}/cmake-build/consumer")
+dqj_run(${CMAKE_COMMAND} -S "${SOURCE}" -B "${WORK}/cmake-build" "-DCMAKE_PREFIX_PATH=${prefix}" "-DCMAKE_C_COMPILER=${CC}")
+dqj_run(${CMAKE_COMMAND} --build "${WORK}/cmake-build")
+dqj_run(${CMAKE_COMMAND} -E env "LD_LIBRARY_PATH=${prefix}/lib" "${WORK}/cmake-build/consumer")
 check_output("find_package(dqjulia)")
 
 # pkg-config
 set(ENV{PKG_CONFIG_PATH} "${prefix}/lib/pkgconfig")
-run(pkg-config --cflags --libs dqjulia)
-string(STRIP "${output}" flags)
+dqj_run(pkg-config --cflags --libs dqjulia)
+string(STRIP "${out}" flags)
 separate_arguments(flags UNIX_COMMAND "${flags}")
-run("${CC}" "${SOURCE}/consumer.c" -o "${WORK}/consumer-pc" ${flags})
-run(${CMAKE_COMMAND} -E env "LD_LIBRARY_PATH=${prefix}/lib" "${WORK}/consumer-pc")
+dqj_run("${CC}" "${SOURCE}/consumer.c" -o "${WORK}/consumer-pc" ${flags})
+dqj_run(${CMAKE_COMMAND} -E env "LD_LIBRARY_PATH=${prefix}/lib" "${WORK}/consumer-pc")
 check_output("pkg-config dqjulia")
 message(STATUS "2 passed, 0 failed")
