@@ -2,6 +2,7 @@
 #   dqjulia/            the Python package, shaders/ and blender_manifest.toml
 #   dqjulia/_buildinfo.py
 #   dqjulia/presets/    examples/*.json
+#   dqjulia/schema.json the parameter schema (dqjulia schema), which props.py builds the properties from
 #   dqjulia/lib/libdqjulia.so   the real library file (not a symlink), stripped
 cmake_minimum_required(VERSION 3.25)
 file(REMOVE_RECURSE "${STAGE}")
@@ -20,6 +21,12 @@ string(REGEX REPLACE "\"version\": \\([0-9, ]+\\)" "\"version\": (${version_tupl
 file(WRITE "${STAGE}/dqjulia/__init__.py" "${text}")
 file(GLOB examples "${EXAMPLES}/*.json")
 file(COPY ${examples} DESTINATION "${STAGE}/dqjulia/presets")
+# The schema the properties are built from, written by the core (tests/blender check it against
+# the library loaded and the properties registered).
+execute_process(COMMAND "${CLI}" schema OUTPUT_FILE "${STAGE}/dqjulia/schema.json" RESULT_VARIABLE result)
+if(NOT result EQUAL 0)
+  message(FATAL_ERROR "could not write the parameter schema (dqjulia schema)")
+endif()
 file(COPY_FILE "${LIBRARY}" "${STAGE}/dqjulia/lib/libdqjulia.so")
 if(STRIP)  # the symbol table is for debuggers; the dynamic symbols (dqj_*) stay
   execute_process(COMMAND "${STRIP}" --strip-unneeded "${STAGE}/dqjulia/lib/libdqjulia.so" RESULT_VARIABLE result)

@@ -105,6 +105,7 @@ _SIGNATURES = {
     "dqj_context_load_params_file": (_status, [_handle, ctypes.c_char_p], True),
     "dqj_context_set_params_json": (_status, [_handle, ctypes.c_char_p], True),
     "dqj_context_get_params_json": (_status, [_handle, ctypes.c_void_p, ctypes.c_size_t, _size_p], True),
+    "dqj_params_schema_json": (_status, [_handle, ctypes.c_void_p, ctypes.c_size_t, _size_p], True),
     "dqj_context_set_constant": (_status, [_handle, ctypes.POINTER(ctypes.c_double)], True),
     "dqj_context_set_variant": (_status, [_handle, ctypes.c_int], True),
     "dqj_context_set_iterations": (_status, [_handle, ctypes.c_int], True),
@@ -366,6 +367,11 @@ class Context:
     def params(self):
         """The complete parameter document the core holds (every key), as a dict."""
         return json.loads(self.params_json())
+
+    def schema(self):
+        """The parameter schema (dqj_params_schema_json) as a dict: every key's type, label, help,
+        default and range. props.py builds the properties from the packaged copy (schema.json)."""
+        return json.loads(self._text_out("dqj_params_schema_json"))
 
     def inspect(self):
         """dqj_inspect_json as a dict: equivalent complex constants, bounds, emptiness and why."""

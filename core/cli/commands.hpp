@@ -18,5 +18,6 @@ Runner addMeshCommand(CLI::App& app);
 Runner addPovrayCommand(CLI::App& app);
 Runner addExploreCommand(CLI::App& app);
 Runner addSheetCommand(CLI::App& app);
+Runner addSchemaCommand(CLI::App& app);
 
 }  // namespace dqj::cli

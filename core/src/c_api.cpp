@@ -294,6 +294,10 @@ dqj_status dqj_context_get_params_json(dqj_context context, char* buffer, size_t
     return guarded(context, [&](dqj_context_t& self) { return copyText(self, dqj::toJson(self.params), buffer, capacity, outSize); });
 }
 
+dqj_status dqj_params_schema_json(dqj_context context, char* buffer, size_t capacity, size_t* outSize) {
+    return guarded(context, [&](dqj_context_t& self) { return copyText(self, dqj::schema::schemaJson(), buffer, capacity, outSize); });
+}
+
 dqj_status dqj_context_set_constant(dqj_context context, const double c[8]) {
     return guarded(context, [&](dqj_context_t& self) {
         if (!c) return invalidArgument(self, "c is NULL");

@@ -87,6 +87,12 @@ DQJ_API dqj_status dqj_context_set_params_json(dqj_context context, const char* 
  * `*out_size` (if not NULL) receives the size needed including the NUL. Call with
  * buffer = NULL, capacity = 0 to query the size. */
 DQJ_API dqj_status dqj_context_get_params_json(dqj_context context, char* buffer, size_t capacity, size_t* out_size);
+/* The parameter schema: JSON describing every key of the parameter document once: its type,
+ * label, help text, default, range (min, max, and the soft range a slider offers) and choices
+ * (README "Parameter schema"). Front ends build their controls from it, as the Blender add-on
+ * does. Same buffer convention as dqj_context_get_params_json; it does not depend on the
+ * context's parameters. */
+DQJ_API dqj_status dqj_params_schema_json(dqj_context context, char* buffer, size_t capacity, size_t* out_size);
 
 /* Single values; each is validated like the parameter file. c: a's s,i,j,k then b's. */
 DQJ_API dqj_status dqj_context_set_constant(dqj_context context, const double c[8]);

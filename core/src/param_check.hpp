@@ -1,0 +1,21 @@
+// param_check.hpp - a JSON value checked against its schema field (internal): the one place a
+// parameter's type and range are enforced, by the file's reader and by validate() alike.
+#pragma once
+
+#include <string>
+
+#include "dqjulia/schema.hpp"
+#include "json_text.hpp"
+
+namespace dqj::detail {
+
+/// Checks `value` at `key` ("lights[1].color") against `field`: its JSON type and, for numbers,
+/// vectors, colours and lists, its range or item count. Objects, axes, rotation planes and the
+/// animation are shaped by their readers and pass unchecked. Throws ParamError(key, prefix +
+/// key + ": " + what is wrong and what is allowed).
+void checkValue(const schema::Field& field, const json::Json& value, const std::string& key, const std::string& prefix);
+
+/// checkValue for every key of a whole document, as toJson writes it.
+void checkDocument(const json::Json& document);
+
+}  // namespace dqj::detail
