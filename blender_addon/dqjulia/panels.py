@@ -199,9 +199,7 @@ class _BakePanel(_Base):
         flow = layout.grid_flow(columns=3, even_columns=True, align=True)
         for name, _label, _description in props.GRID_ITEMS:
             flow.prop_enum(s, "bake_grids", name)
-        layout.prop(s, "bake_band_width")
-        layout.prop(s, "bake_adaptivity")
-        layout.prop(s, "bake_mesh_colors")
+        props.draw_fields(layout, s, props.section_keys("bake", exclude=("bake.resolution",)))
         layout.prop(s, "bake_bounds_auto")
         if not s.bake_bounds_auto:
             layout.prop(s, "bake_bounds_min")
@@ -255,8 +253,7 @@ class _ShadingPanel(_Base):
         remove.collection, remove.action = "palette", "REMOVE"
         for entry in s.palette:
             column.prop(entry, "color", text="")
-        for name in ("ambient", "diffuse", "specular", "shininess", "occlusion", "shadows", "shadow_softness"):
-            column.prop(s, name)
+        props.draw_fields(column, s, props.section_keys("material", exclude=("material.color", "material.coloring")))
         row = column.row()
         row.label(text="Lights")
         add = row.operator(operators.DQJULIA_OT_collection_edit.bl_idname, text="", icon="ADD")
@@ -270,22 +267,14 @@ class _ShadingPanel(_Base):
             row.prop(light, "color", text="")
             row.prop(light, "intensity")
         column.separator()
-        column.prop(s, "camera_use_position")
-        if s.camera_use_position:
-            column.prop(s, "camera_position")
-        column.prop(s, "camera_use_target")
-        if s.camera_use_target:
-            column.prop(s, "camera_target")
-        column.prop(s, "camera_direction")
-        column.prop(s, "camera_up")
-        column.prop(s, "camera_fov")
+        props.draw_fields(column, s, props.section_keys("camera"))
         column.separator()
         row = column.row(align=True)
         row.prop(s, "width")
         row.prop(s, "height")
-        for name in ("samples", "max_steps", "detail", "normals", "background_top", "background_bottom",
-                     "output_path", "output_format", "description"):
-            column.prop(s, name)
+        props.draw_fields(column, s, props.section_keys("render", exclude=(
+            "render.width", "render.height", "render.step_factor", "render.max_step")))
+        props.draw_fields(column, s, props.section_keys("output") + ["description"])
 
 
 def _make_panels():

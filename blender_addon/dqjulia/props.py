@@ -1,14 +1,19 @@
 """The parameters on the object: a PropertyGroup (Object.dqjulia) holding everything the
 parameter file holds, and the two-way mapping between it and the file's JSON document.
 
-Every value is an ordinary Blender property, so it can be keyframed, driven and edited in
-the UI. The file's format belongs to the core: documents are always validated by the library
-(native.Context.set_params) and read back complete from it (Context.params), so this module
-only maps names. Sections of a file this version does not model are kept verbatim in
-`extra_json` and written back on export.
+The properties are built from the core's parameter schema (schema.json in the add-on, written
+by `dqjulia schema` when the add-on is packaged: every key's type, label, help, default and
+range, once, in the core). Each key becomes one property, named by one rule (prop_name); this
+module only adds what the file has no key for (the slice axes' two forms, the preview's own
+settings) and the few shapes that need two controls (c as a and b, "auto" objects, optional
+values). Every value is an ordinary Blender property, so it can be keyframed, driven and edited
+in the UI. Documents are always validated by the library (native.Context.set_params) and read
+back complete from it (Context.params). Sections of a file this version does not model are
+kept verbatim in `extra_json` and written back on export.
 """
 
 import json
+import os
 import struct
 
 import bpy
@@ -17,45 +22,51 @@ from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProp
 
 from .slicing import AXIS_NAMES
 
-FORMAT_VERSION = 1
+SCHEMA_PATH = os.path.join(os.path.dirname(__file__), "schema.json")
+with open(SCHEMA_PATH, encoding="utf-8") as _file:
+    SCHEMA = json.load(_file)
+FIELDS = {field["key"]: field for field in SCHEMA["fields"]}
+FORMAT_VERSION = SCHEMA["format_version"]
 # Top-level keys mapped to properties; anything else is kept verbatim (extra_json).
-MODELED_SECTIONS = ("version", "description", "fractal", "slice", "bounds", "camera", "lights", "material",
-                    "render", "output", "bake", "animation")
+MODELED_SECTIONS = ("version",) + tuple(key for key in FIELDS if "." not in key and "[" not in key)
+# Sections whose keys are properties without the section's name ("fractal.iterations" -> iterations).
+_BARE_SECTIONS = ("fractal", "slice", "material", "render")
+_FLOAT_MAX = 3.0e38  # Blender stores single-precision floats
 
-VARIANT_ITEMS = [
-    ("paper", "Paper", "The paper's rule a^2 + b^2 eps: real and dual parts iterate independently; "
-                       "escape when |a| > R or |b| > R"),
-    ("paper-coupled", "Paper, coupled", "The paper's rule with one 8-D norm for escape and distance estimate"),
-    ("dual", "Dual", "The true dual-quaternion algebra a^2 + (ab + ba) eps; escape on |a|"),
-]
+
+def prop_name(key):
+    """The property of a schema key: "fractal.iterations" -> "iterations", "bake.band_width" ->
+    "bake_band_width", "lights[].color" -> "color" (on the list's item)."""
+    if "[]" in key:
+        return key.rsplit("[]", 1)[1].lstrip(".") or "color"
+    section, _, rest = key.partition(".")
+    if section in _BARE_SECTIONS and rest:
+        key = rest
+    return key.replace(".", "_")
+
+
+def use_name(key):
+    """The toggle of an optional vector: "camera.position" -> "camera_use_position"."""
+    section, _, leaf = key.rpartition(".")
+    return "%s_use_%s" % (section.replace(".", "_"), leaf)
+
+
+def choice_items(key):
+    field = FIELDS[key]
+    items = [(choice["name"], choice["label"], choice["help"]) for choice in field["choices"]]
+    if field.get("optional"):
+        items.insert(0, ("AUTO", "Automatic", field["help"]))
+    return items
+
+
+VARIANT_ITEMS = choice_items("fractal.variant")
+COLORING_ITEMS = choice_items("material.coloring")
+GRID_ITEMS = choice_items("bake.grids")
 AXIS_ITEMS = [(name, name, "%s part, %s component" % ("real" if name[0] == "a" else "dual", name[2]))
               for name in AXIS_NAMES]
 AXES_MODE_ITEMS = [
     ("NAMES", "Axis names", "Each of x, y, z runs along one 8-D coordinate axis"),
     ("VECTORS", "Vectors", "Each of x, y, z runs along an 8-D vector"),
-]
-COLORING_ITEMS = [
-    ("solid", "Solid", "The material colour"),
-    ("iterations", "Iterations", "The smooth escape count through the palette"),
-    ("trap", "Orbit trap", "The orbit's closest approach to 0 through the palette"),
-]
-NORMALS_ITEMS = [
-    ("auto", "Auto", "Analytic for the dual variant, central differences otherwise"),
-    ("central", "Central differences", "Differences of the distance estimate"),
-    ("analytic", "Analytic", "Exact, from the dual part (dual variant only)"),
-]
-FORMAT_ITEMS = [
-    ("AUTO", "From extension", "From the output path's extension"),
-    ("png8", "PNG 8-bit", ""),
-    ("png16", "PNG 16-bit", ""),
-    ("exr", "OpenEXR", "Premultiplied linear RGBA, depth and normals"),
-]
-GRID_ITEMS = [
-    ("surface", "Surface", "Narrow-band level set of the surface"),
-    ("density", "Density", "Fog volume: 1 inside, 0 outside (what Blender renders)"),
-    ("color", "Color", "Linear RGB from the material's colouring"),
-    ("trap", "Trap", "The orbit trap value"),
-    ("iterations", "Iterations", "The smooth escape count"),
 ]
 
 
@@ -69,142 +80,147 @@ def _redraw(_self, context):
             area.tag_redraw()
 
 
-def _vector(name, size, default, description, soft=2.0, hard=100.0, subtype="NONE", update=_redraw):
-    return FloatVectorProperty(name=name, size=size, default=default, description=description, soft_min=-soft,
-                               soft_max=soft, min=-hard, max=hard, precision=5, step=1, subtype=subtype,
-                               update=update)
+def _limits(field):
+    """Blender's min, max, soft_min and soft_max for a field (exclusive limits nudged inside)."""
+    low, high = field["min"], field["max"]
+    nudge = 1e-3 if high - low <= 1000 else 1e-6
+    if field.get("min_exclusive"):
+        low += nudge
+    if field.get("max_exclusive"):
+        high -= nudge
+    low, high = max(low, -_FLOAT_MAX), min(high, _FLOAT_MAX)
+    return {"min": low, "max": high, "soft_min": max(low, field["soft_min"]), "soft_max": min(high, field["soft_max"])}
 
 
-def _color(name, default, description=""):
-    return FloatVectorProperty(name=name, size=3, default=default, min=0.0, soft_max=1.0, max=1000.0,
-                               subtype="COLOR", description=description, update=_redraw)
+def _initial(field):
+    """The value a property starts from: the default, or for optional keys and "auto" objects
+    the value the core suggests when they are turned on."""
+    value = field.get("default")
+    if value is None or value == "auto":
+        value = field.get("initial", value)
+    return value
 
 
-class DQJRotation(bpy.types.PropertyGroup):
-    """A rotation of the slice's axes in a plane of the 8-D space (slice.rotations[])."""
-    first: EnumProperty(name="From", items=AXIS_ITEMS, default="a.j", update=_redraw,
-                        description="The rotation turns this axis towards the other")
-    second: EnumProperty(name="To", items=AXIS_ITEMS, default="b.s", update=_redraw)
-    degrees: FloatProperty(name="Degrees", default=0.0, min=-36000.0, max=36000.0, soft_min=-180.0, soft_max=180.0,
-                           update=_redraw, description="Angle of the rotation (animatable)")
+def make_property(key, **overrides):
+    """The Blender property of a schema key (not for lists, objects or axes)."""
+    field = FIELDS[key]
+    kind = field["type"]
+    options = {"name": field["label"], "description": field["help"]}
+    if not field.get("image_only"):
+        options["update"] = _redraw
+    value = _initial(field)
+    if kind == "boolean":
+        return BoolProperty(default=bool(value), **options, **overrides)
+    if kind == "integer":
+        limits = {name: int(limit) for name, limit in _limits(field).items()}
+        return IntProperty(default=int(value), **limits, **options, **overrides)
+    if kind == "number":
+        return FloatProperty(default=float(value), precision=4, **_limits(field), **options, **overrides)
+    if kind == "string":
+        subtype = "FILE_PATH" if key.endswith("path") else "NONE"
+        return StringProperty(default=value or "", subtype=subtype, **options, **overrides)
+    if kind == "choice":
+        return EnumProperty(items=choice_items(key), default=field["default"] or "AUTO", **options, **overrides)
+    if kind == "choice_set":
+        return EnumProperty(items=choice_items(key), options={"ENUM_FLAG"}, default=set(value), **options, **overrides)
+    if kind in ("vec3", "color", "vec8"):
+        size = 8 if kind == "vec8" else 3
+        subtype = "COLOR" if kind == "color" else "NONE"
+        return FloatVectorProperty(size=size, default=tuple(value), subtype=subtype, precision=5, step=1,
+                                   **_limits(field), **options, **overrides)
+    raise ValueError("no property for schema key %s (%s)" % (key, kind))
 
 
-class DQJLight(bpy.types.PropertyGroup):
-    """A directional light of the core's renderer and the preview (lights[])."""
-    direction: _vector("Direction", 3, (0.6, 0.8, 0.7), "Towards the light, in the object's coordinates",
-                       hard=1e9)
-    color: _color("Color", (1.0, 1.0, 1.0), "Linear RGB")
-    intensity: FloatProperty(name="Intensity", default=1.0, min=0.0, max=1000.0, soft_max=4.0, update=_redraw)
+def _quaternion_halves(key):
+    """fractal.c as two 4-vectors "<name>_a" (real part) and "<name>_b" (dual part)."""
+    field = FIELDS[key]
+    halves = {}
+    for suffix, part, values in (("a", "real", field["default"][:4]), ("b", "dual", field["default"][4:])):
+        halves["%s_%s" % (prop_name(key), suffix)] = FloatVectorProperty(
+            name="%s %s" % (field["label"], suffix), size=4, default=tuple(values), precision=5, step=1,
+            description="%s: %s part (s, i, j, k)" % (field["help"], part), update=_redraw, **_limits(field))
+    return halves
 
 
-class DQJColor(bpy.types.PropertyGroup):
-    color: _color("Color", (1.0, 1.0, 1.0))
+def _annotations(prefix):
+    """The properties of every value key under `prefix` ("lights[]." for a light's)."""
+    annotations = {}
+    for key, field in FIELDS.items():
+        if not key.startswith(prefix) or "[]" in key[len(prefix):] or field["type"] in ("object", "list",
+                                                                                          "color_list", "animation"):
+            continue
+        if prefix == "" and "[]" in key:
+            continue
+        kind = field["type"]
+        if kind == "dual_quaternion":
+            annotations.update(_quaternion_halves(key))
+        elif kind in ("axes", "axis_pair"):
+            continue  # two controls each, below
+        else:
+            annotations[prop_name(key)] = make_property(key)
+            if field.get("optional") and kind != "choice":
+                annotations[use_name(key)] = BoolProperty(name=field["label"], default=False,
+                                                          description="Set: " + field["help"])
+    return annotations
 
 
-class DQJuliaSettings(bpy.types.PropertyGroup):
-    """Everything the parameter file holds (README "Parameter file"), plus the preview's options."""
-    enabled: BoolProperty(name="DQ Julia object", default=False,
-                          description="This object shows a dual-quaternion Julia set inside its bounds")
-    description: StringProperty(name="Description", description="Free text, kept in the parameter file")
+def _auto_toggles():
+    """For each "auto" object ("bounds"), the toggle "<name>_auto" (on = "auto")."""
+    return {prop_name(key) + "_auto": BoolProperty(name="Automatic " + field["label"].lower(), default=True,
+                                                   update=_redraw, description=field["help"])
+            for key, field in FIELDS.items() if field.get("auto")}
 
-    # fractal
-    c_a: _vector("Constant a", 4, (-0.39054, -0.58679, 0.0, 0.0),
-                 "Real part of the constant c, (s, i, j, k) scalar first")
-    c_b: _vector("Constant b", 4, (0.0, 0.5632, 0.0, 0.05), "Dual part of the constant c, (s, i, j, k)")
-    variant: EnumProperty(name="Variant", items=VARIANT_ITEMS, default="paper", update=_redraw)
-    iterations: IntProperty(name="Iterations", default=15, min=1, max=100000, soft_max=200, update=_redraw,
-                            description="N, the iteration count (the paper uses 6 to 15)")
-    bailout: FloatProperty(name="Bailout", default=4.0, min=1.0, soft_max=20.0, precision=4, update=_redraw,
-                           description="R, at least the containment radius r_K of the constant")
 
-    # slice
-    axes_mode: EnumProperty(name="Axes", items=AXES_MODE_ITEMS, default="NAMES", update=_redraw)
-    axis_x: EnumProperty(name="x", items=AXIS_ITEMS, default="a.s", update=_redraw)
-    axis_y: EnumProperty(name="y", items=AXIS_ITEMS, default="a.i", update=_redraw)
-    axis_z: EnumProperty(name="z", items=AXIS_ITEMS, default="a.j", update=_redraw)
-    axis_x_vector: _vector("x axis", 8, (1, 0, 0, 0, 0, 0, 0, 0), "Where x goes in 8-D", hard=1e9)
-    axis_y_vector: _vector("y axis", 8, (0, 1, 0, 0, 0, 0, 0, 0), "Where y goes in 8-D", hard=1e9)
-    axis_z_vector: _vector("z axis", 8, (0, 0, 1, 0, 0, 0, 0, 0), "Where z goes in 8-D", hard=1e9)
-    origin: _vector("Origin", 8, (0.0,) * 8, "The 8-D point at x = y = z = 0 (a's s, i, j, k, then b's)", hard=1e9)
-    rotations: CollectionProperty(type=DQJRotation, name="Rotations")
-    active_rotation: IntProperty(name="Active rotation", default=0, min=0)
+def _group(name, doc, annotations):
+    return type(name, (bpy.types.PropertyGroup,), {"__annotations__": annotations, "__doc__": doc})
 
-    # bounds
-    bounds_auto: BoolProperty(name="Automatic bounds", default=True, update=_redraw,
-                              description="The smallest sphere holding the slice's share of the containment region")
-    bounds_center: _vector("Center", 3, (0.0, 0.0, 0.0), "Centre of the bounding sphere", hard=1e9)
-    bounds_radius: FloatProperty(name="Radius", default=2.0, min=1e-6, max=1e6, soft_max=10.0, update=_redraw)
 
-    # camera (for renders by the core; the preview uses Blender's view)
-    camera_use_position: BoolProperty(name="Camera position", default=False)
-    camera_position: _vector("Position", 3, (0.0, 0.0, 5.0), "", hard=1e9, update=None)
-    camera_use_target: BoolProperty(name="Camera target", default=False)
-    camera_target: _vector("Target", 3, (0.0, 0.0, 0.0), "", hard=1e9, update=None)
-    camera_direction: _vector("Direction", 3, (0.55, 0.45, 1.0), "From the target towards the camera", hard=1e9,
-                              update=None)
-    camera_up: _vector("Up", 3, (0.0, 1.0, 0.0), "", hard=1e9, update=None)
-    camera_fov: FloatProperty(name="Field of view", default=40.0, min=0.001, max=169.999)
+_first, _second = FIELDS["slice.rotations[].plane"]["default"].split(",")
+DQJRotation = _group("DQJRotation", "A rotation of the slice's axes in a plane of the 8-D space (slice.rotations[]).", {
+    "first": EnumProperty(name="From", items=AXIS_ITEMS, default=_first, update=_redraw,
+                          description=FIELDS["slice.rotations[].plane"]["help"]),
+    "second": EnumProperty(name="To", items=AXIS_ITEMS, default=_second, update=_redraw),
+    **_annotations("slice.rotations[]."),
+})
+DQJLight = _group("DQJLight", "A directional light of the core's renderer and the preview (lights[]).",
+                  _annotations("lights[]."))
+DQJColor = _group("DQJColor", "A palette colour (material.palette[]).", {"color": make_property("material.palette[]")})
 
-    lights: CollectionProperty(type=DQJLight, name="Lights")
-
-    # material
-    color: _color("Color", (0.85, 0.62, 0.35), "Base colour for solid colouring (linear RGB)")
-    coloring: EnumProperty(name="Coloring", items=COLORING_ITEMS, default="trap", update=_redraw)
-    palette: CollectionProperty(type=DQJColor, name="Palette")
-    ambient: FloatProperty(name="Ambient", default=0.15, min=0.0, max=100.0, soft_max=1.0, update=_redraw)
-    diffuse: FloatProperty(name="Diffuse", default=0.8, min=0.0, max=100.0, soft_max=1.0, update=_redraw)
-    specular: FloatProperty(name="Specular", default=0.35, min=0.0, max=100.0, soft_max=1.0, update=_redraw)
-    shininess: FloatProperty(name="Shininess", default=24.0, min=0.0, max=10000.0, soft_max=200.0, update=_redraw)
-    occlusion: FloatProperty(name="Occlusion", default=0.8, min=0.0, max=1.0)
-    shadows: BoolProperty(name="Shadows", default=True)
-    shadow_softness: FloatProperty(name="Shadow softness", default=12.0, min=0.001, max=1000.0)
-
-    # render (the core's renderer; step settings also drive the preview)
-    width: IntProperty(name="Width", default=640, min=1, max=16384)
-    height: IntProperty(name="Height", default=480, min=1, max=16384)
-    samples: IntProperty(name="Samples", default=2, min=1, max=16)
-    step_factor: FloatProperty(name="Step factor", default=0.9, min=0.001, max=1.0, update=_redraw)
-    max_step: FloatProperty(name="Max step", default=0.25, min=1e-6, max=1e6, soft_max=1.0, update=_redraw)
-    max_steps: IntProperty(name="Max steps", default=400, min=1, max=1000000, soft_max=2000, update=_redraw)
-    detail: FloatProperty(name="Detail", default=1.0, min=0.001, max=1000.0, soft_max=8.0, update=_redraw,
-                          description="Hit threshold in pixel footprints (smaller = finer)")
-    normals: EnumProperty(name="Normals", items=NORMALS_ITEMS, default="auto")
-    background_top: _color("Background top", (0.3, 0.36, 0.45))
-    background_bottom: _color("Background bottom", (0.06, 0.06, 0.08))
-
-    # output
-    output_path: StringProperty(name="Output", default="out/dqjulia.png", subtype="FILE_PATH")
-    output_format: EnumProperty(name="Format", items=FORMAT_ITEMS, default="AUTO")
-
-    # bake
-    bake_resolution: IntProperty(name="Resolution", default=128, min=8, max=16384, soft_max=1024,
-                                 description="Voxels across the largest side of the bake bounds")
-    bake_bounds_auto: BoolProperty(name="Automatic bake bounds", default=True,
-                                   description="The cube around the bounding sphere, clipped to the sphere")
-    bake_bounds_min: _vector("Min", 3, (-1.0, -1.0, -1.0), "", hard=1e6, update=None)
-    bake_bounds_max: _vector("Max", 3, (1.0, 1.0, 1.0), "", hard=1e6, update=None)
-    bake_band_width: FloatProperty(name="Band width", default=3.0, min=1.0, max=32.0,
-                                   description="Half width of the level set's narrow band, in voxels")
-    bake_grids: EnumProperty(name="Grids", items=GRID_ITEMS, options={"ENUM_FLAG"}, default={"surface", "density"})
-    bake_adaptivity: FloatProperty(name="Adaptivity", default=0.0, min=0.0, max=1.0,
-                                   description="Mesh adaptivity: 0 = uniform triangles, more = fewer triangles")
-    bake_mesh_colors: BoolProperty(name="Vertex colours", default=True)
-
+_axes = FIELDS["slice.axes"]["default"].split(",")
+_settings = {
+    "enabled": BoolProperty(name="DQ Julia object", default=False,
+                            description="This object shows a dual-quaternion Julia set inside its bounds"),
+    **_annotations(""),
+    **_auto_toggles(),
+    # slice.axes: names or vectors
+    "axes_mode": EnumProperty(name="Axes", items=AXES_MODE_ITEMS, default="NAMES", update=_redraw),
+    "rotations": CollectionProperty(type=DQJRotation, name=FIELDS["slice.rotations"]["label"]),
+    "active_rotation": IntProperty(name="Active rotation", default=0, min=0),
+    "lights": CollectionProperty(type=DQJLight, name=FIELDS["lights"]["label"]),
+    "palette": CollectionProperty(type=DQJColor, name=FIELDS["material.palette"]["label"]),
     # the preview (not in the file)
-    show_preview: BoolProperty(name="Preview", default=True, update=_redraw,
-                               description="Ray-march the set in the viewport (GLSL)")
-    show_bounds: BoolProperty(name="Bounds", default=True, update=_redraw,
-                              description="Draw the bounding sphere as three circles")
-    preview_resolution: IntProperty(name="Preview pixel size", default=1, min=1, max=8, update=_redraw,
-                                    description="March one ray per N x N viewport pixels (faster on slow GPUs)")
-    preview_max_steps: IntProperty(name="Preview steps", default=160, min=8, max=100000, soft_max=1000,
-                                   update=_redraw, description="Most steps a preview ray takes (cost)")
-    preview_detail: FloatProperty(name="Preview detail", default=1.0, min=0.01, max=100.0, soft_max=8.0,
-                                  update=_redraw, description="Hit threshold in pixels for the preview")
-
+    "show_preview": BoolProperty(name="Preview", default=True, update=_redraw,
+                                 description="Ray-march the set in the viewport (GLSL)"),
+    "show_bounds": BoolProperty(name="Bounds", default=True, update=_redraw,
+                                description="Draw the bounding sphere as three circles"),
+    "preview_resolution": IntProperty(name="Preview pixel size", default=1, min=1, max=8, update=_redraw,
+                                      description="March one ray per N x N viewport pixels (faster on slow GPUs)"),
+    "preview_max_steps": IntProperty(name="Preview steps", default=160, min=8, max=100000, soft_max=1000,
+                                     update=_redraw, description="Most steps a preview ray takes (cost)"),
+    "preview_detail": FloatProperty(name="Preview detail", default=1.0, min=0.01, max=100.0, soft_max=8.0,
+                                    update=_redraw, description="Hit threshold in pixels for the preview"),
     # sections of an imported file this version does not model, written back on export
-    extra_json: StringProperty(name="Other sections", default="{}", options={"HIDDEN"})
-
+    "extra_json": StringProperty(name="Other sections", default="{}", options={"HIDDEN"}),
+}
+for _index, _axis in enumerate("xyz"):
+    _settings["axis_" + _axis] = EnumProperty(name=_axis, items=AXIS_ITEMS, default=_axes[_index], update=_redraw)
+    _unit = [0.0] * 8
+    _unit[AXIS_NAMES.index(_axes[_index])] = 1.0
+    _settings["axis_%s_vector" % _axis] = FloatVectorProperty(
+        name="%s axis" % _axis, size=8, default=tuple(_unit), precision=5, step=1, update=_redraw,
+        description="Where %s goes in 8-D" % _axis, **_limits(FIELDS["slice.axes"]))
+DQJuliaSettings = _group("DQJuliaSettings", "Everything the parameter file holds (README \"Parameter file\"), plus "
+                                            "the preview's options.", _settings)
 
 CLASSES = (DQJRotation, DQJLight, DQJColor, DQJuliaSettings)
 
@@ -235,6 +251,61 @@ def _value(settings, path, values):
     return getattr(settings, path)
 
 
+def _json_value(field, value):
+    """A property's value as the document writes it."""
+    kind = field["type"]
+    if kind == "boolean":
+        return bool(value)
+    if kind == "integer":
+        return int(value)
+    if kind == "number":
+        return _number(value)
+    if kind in ("vec3", "color", "vec8"):
+        return _numbers(value)
+    if kind == "choice_set":
+        return [name for name, _label, _help in choice_items(field["key"]) if name in value]
+    return value
+
+
+def _put(document, key, value):
+    """document["a"]["b"] = value for key "a.b"."""
+    *sections, leaf = key.split(".")
+    for section in sections:
+        document = document.setdefault(section, {})
+    document[leaf] = value
+
+
+def _get(document, key):
+    """document["a"]["b"] for key "a.b", or None where absent."""
+    for part in key.split("."):
+        if not isinstance(document, dict) or part not in document:
+            return None
+        document = document[part]
+    return document
+
+
+def _value_keys(prefix=""):
+    """The schema's value keys directly under `prefix`, in file order (not lists' items)."""
+    for key, field in FIELDS.items():
+        if key.startswith(prefix) and "[]" not in key[len(prefix):] and (prefix or "[]" not in key) and \
+                field["type"] not in ("object", "list", "color_list", "animation"):
+            yield key, field
+
+
+def _inside_auto(key):
+    """The "auto" object a key belongs to ("bounds.center" -> "bounds"), or None."""
+    for other, field in FIELDS.items():
+        if field.get("auto") and key.startswith(other + "."):
+            return other
+    return None
+
+
+def _item(item, prefix):
+    """A list item's document from its properties (a light, a rotation)."""
+    return {key[len(prefix):]: _json_value(field, getattr(item, prop_name(key))) for key, field in _value_keys(prefix)
+            if field["type"] != "axis_pair"}
+
+
 def to_document(settings, values=None, with_animation=None):
     """The parameter document of these properties (a dict, not yet validated by the core).
 
@@ -242,66 +313,44 @@ def to_document(settings, values=None, with_animation=None):
     with_animation: an "animation" dict to include (see animation.py), or None for none.
     """
     s = settings
-    c = list(_value(s, "c_a", values)) + list(_value(s, "c_b", values))
     document = {"version": FORMAT_VERSION}
-    if s.description:
-        document["description"] = s.description
-    document["fractal"] = {
-        "c": _numbers(c),
-        "variant": s.variant,
-        "iterations": int(_value(s, "iterations", values)),
-        "bailout": _number(_value(s, "bailout", values)),
-    }
-    if s.axes_mode == "NAMES":
-        axes = ",".join((s.axis_x, s.axis_y, s.axis_z))
-    else:
-        axes = [_numbers(s.axis_x_vector), _numbers(s.axis_y_vector), _numbers(s.axis_z_vector)]
+    for key, field in _value_keys():
+        kind, name = field["type"], prop_name(key)
+        auto = _inside_auto(key)
+        if auto and getattr(s, prop_name(auto) + "_auto"):
+            document_value = None
+        elif kind == "dual_quaternion":
+            document_value = _numbers(list(_value(s, name + "_a", values)) + list(_value(s, name + "_b", values)))
+        elif kind == "axes":
+            if s.axes_mode == "NAMES":
+                document_value = ",".join((s.axis_x, s.axis_y, s.axis_z))
+            else:
+                document_value = [_numbers(s.axis_x_vector), _numbers(s.axis_y_vector), _numbers(s.axis_z_vector)]
+        elif field.get("optional") and kind != "choice" and not getattr(s, use_name(key)):
+            document_value = None
+        else:
+            document_value = _json_value(field, _value(s, name, values))
+            if kind == "choice" and document_value == "AUTO":
+                document_value = None
+            if key == "description" and not document_value:
+                document_value = None
+        if document_value is not None:
+            _put(document, key, document_value)
+    for key, field in FIELDS.items():
+        if field.get("auto") and getattr(s, prop_name(key) + "_auto"):
+            _put(document, key, "auto")
     rotations = []
     for index, rotation in enumerate(s.rotations):
-        degrees = _value(s, "rotations[%d].degrees" % index, values) if values else rotation.degrees
-        rotations.append({"plane": "%s,%s" % (rotation.first, rotation.second), "degrees": _number(degrees)})
-    document["slice"] = {"axes": axes, "origin": _numbers(_value(s, "origin", values)), "rotations": rotations}
-    if s.bounds_auto:
-        document["bounds"] = "auto"
-    else:
-        document["bounds"] = {"center": _numbers(s.bounds_center), "radius": _number(s.bounds_radius)}
-    camera = {}
-    if s.camera_use_position:
-        camera["position"] = _numbers(s.camera_position)
-    if s.camera_use_target:
-        camera["target"] = _numbers(s.camera_target)
-    camera.update({"direction": _numbers(s.camera_direction), "up": _numbers(s.camera_up),
-                   "fov": _number(s.camera_fov)})
-    document["camera"] = camera
-    document["lights"] = [{"direction": _numbers(light.direction), "color": _numbers(light.color),
-                           "intensity": _number(light.intensity)} for light in s.lights]
-    document["material"] = {
-        "color": _numbers(s.color), "coloring": s.coloring,
-        "palette": [_numbers(entry.color) for entry in s.palette] or [_numbers(s.color)],
-        "ambient": _number(s.ambient), "diffuse": _number(s.diffuse), "specular": _number(s.specular),
-        "shininess": _number(s.shininess), "occlusion": _number(s.occlusion), "shadows": bool(s.shadows),
-        "shadow_softness": _number(s.shadow_softness),
-    }
-    document["render"] = {
-        "width": s.width, "height": s.height, "samples": s.samples, "step_factor": _number(s.step_factor),
-        "max_step": _number(s.max_step), "max_steps": s.max_steps, "detail": _number(s.detail),
-        "normals": s.normals,
-        "background": {"top": _numbers(s.background_top), "bottom": _numbers(s.background_bottom)},
-    }
-    output = {"path": s.output_path}
-    if s.output_format != "AUTO":
-        output["format"] = s.output_format
-    document["output"] = output
-    grids = [name for name, _label, _description in GRID_ITEMS if name in s.bake_grids]
-    document["bake"] = {
-        "resolution": s.bake_resolution,
-        "bounds": "auto" if s.bake_bounds_auto else {"min": _numbers(s.bake_bounds_min),
-                                                     "max": _numbers(s.bake_bounds_max)},
-        "band_width": _number(s.bake_band_width),
-        "grids": grids or ["surface", "density"],
-        "adaptivity": _number(s.bake_adaptivity),
-        "mesh_colors": bool(s.bake_mesh_colors),
-    }
+        item = _item(rotation, "slice.rotations[].")
+        item["plane"] = "%s,%s" % (rotation.first, rotation.second)
+        if values:
+            item["degrees"] = _number(_value(s, "rotations[%d].degrees" % index, values))
+        rotations.append(item)
+    _put(document, "slice.rotations", rotations)
+    document["lights"] = [_item(light, "lights[].") for light in s.lights]
+    _put(document, "material.palette", [_numbers(entry.color) for entry in s.palette] or [_numbers(s.color)])
+    if not document["bake"].get("grids"):
+        document["bake"]["grids"] = FIELDS["bake.grids"]["default"]
     if with_animation:
         document["animation"] = with_animation
     try:
@@ -314,101 +363,81 @@ def to_document(settings, values=None, with_animation=None):
     return document
 
 
+def _set_item(item, prefix, document):
+    for key, field in _value_keys(prefix):
+        if field["type"] != "axis_pair":
+            setattr(item, prop_name(key), document[key[len(prefix):]])
+
+
 def from_document(settings, document):
     """Sets the properties from a complete document (as the core returns it). The "animation"
     section is not applied here (animation.py turns it into keyframes)."""
     s = settings
-    s.description = document.get("description", "")
-    fractal = document["fractal"]
-    s.c_a = fractal["c"][:4]
-    s.c_b = fractal["c"][4:]
-    s.variant = fractal["variant"]
-    s.iterations = int(fractal["iterations"])
-    s.bailout = fractal["bailout"]
-
-    slice_doc = document["slice"]
-    axes = slice_doc["axes"]
-    if isinstance(axes, str):
-        s.axes_mode = "NAMES"
-        s.axis_x, s.axis_y, s.axis_z = [name.strip() for name in axes.split(",")]
-        vectors = []
-        for name in (s.axis_x, s.axis_y, s.axis_z):
-            vector = [0.0] * 8
-            vector[AXIS_NAMES.index(name)] = 1.0
-            vectors.append(vector)
-    else:
-        s.axes_mode = "VECTORS"
-        vectors = axes
-    s.axis_x_vector, s.axis_y_vector, s.axis_z_vector = vectors
-    s.origin = slice_doc["origin"]
+    for key, field in _value_keys():
+        kind, name = field["type"], prop_name(key)
+        value = _get(document, key)
+        auto = _inside_auto(key)
+        if auto:
+            auto_on = _get(document, auto) == "auto"
+            setattr(s, prop_name(auto) + "_auto", auto_on)
+            if auto_on:
+                continue
+        if kind == "dual_quaternion":
+            setattr(s, name + "_a", value[:4])
+            setattr(s, name + "_b", value[4:])
+        elif kind == "axes":
+            if isinstance(value, str):
+                s.axes_mode = "NAMES"
+                s.axis_x, s.axis_y, s.axis_z = [axis.strip() for axis in value.split(",")]
+                vectors = []
+                for axis in (s.axis_x, s.axis_y, s.axis_z):
+                    vector = [0.0] * 8
+                    vector[AXIS_NAMES.index(axis)] = 1.0
+                    vectors.append(vector)
+            else:
+                s.axes_mode = "VECTORS"
+                vectors = value
+            s.axis_x_vector, s.axis_y_vector, s.axis_z_vector = vectors
+        elif field.get("optional") and kind != "choice":
+            setattr(s, use_name(key), value is not None)
+            if value is not None:
+                setattr(s, name, value)
+        elif kind == "choice_set":
+            setattr(s, name, set(value))
+        elif value is None:
+            setattr(s, name, "AUTO" if kind == "choice" else _initial(field))
+        else:
+            setattr(s, name, value)
     s.rotations.clear()
-    for rotation in slice_doc["rotations"]:
+    for rotation in _get(document, "slice.rotations"):
         item = s.rotations.add()
         item.first, item.second = [name.strip() for name in rotation["plane"].split(",")]
-        item.degrees = rotation["degrees"]
+        _set_item(item, "slice.rotations[].", rotation)
     s.active_rotation = max(0, min(s.active_rotation, len(s.rotations) - 1))
-
-    bounds = document["bounds"]
-    s.bounds_auto = bounds == "auto"
-    if not s.bounds_auto:
-        s.bounds_center = bounds["center"]
-        s.bounds_radius = bounds["radius"]
-
-    camera = document["camera"]
-    s.camera_use_position = "position" in camera
-    if s.camera_use_position:
-        s.camera_position = camera["position"]
-    s.camera_use_target = "target" in camera
-    if s.camera_use_target:
-        s.camera_target = camera["target"]
-    s.camera_direction = camera["direction"]
-    s.camera_up = camera["up"]
-    s.camera_fov = camera["fov"]
-
     s.lights.clear()
     for light in document["lights"]:
-        item = s.lights.add()
-        item.direction = light["direction"]
-        item.color = light["color"]
-        item.intensity = light["intensity"]
-
-    material = document["material"]
-    s.color = material["color"]
-    s.coloring = material["coloring"]
+        _set_item(s.lights.add(), "lights[].", light)
     s.palette.clear()
-    for colour in material["palette"]:
+    for colour in _get(document, "material.palette"):
         s.palette.add().color = colour
-    for key in ("ambient", "diffuse", "specular", "shininess", "occlusion", "shadows"):
-        setattr(s, key, material[key])
-    s.shadow_softness = material["shadow_softness"]
-
-    render = document["render"]
-    for key in ("width", "height", "samples", "step_factor", "max_step", "max_steps", "detail", "normals"):
-        setattr(s, key, render[key])
-    background = render["background"]
-    if isinstance(background, dict):
-        s.background_top = background["top"]
-        s.background_bottom = background["bottom"]
-    else:
-        s.background_top = s.background_bottom = background
-
-    output = document["output"]
-    s.output_path = output["path"]
-    s.output_format = output.get("format", "AUTO")
-
-    bake = document.get("bake")
-    if bake:
-        s.bake_resolution = bake["resolution"]
-        s.bake_bounds_auto = bake["bounds"] == "auto"
-        if not s.bake_bounds_auto:
-            s.bake_bounds_min = bake["bounds"]["min"]
-            s.bake_bounds_max = bake["bounds"]["max"]
-        s.bake_band_width = bake["band_width"]
-        s.bake_grids = set(bake["grids"])
-        s.bake_adaptivity = bake["adaptivity"]
-        s.bake_mesh_colors = bake["mesh_colors"]
-
     s.extra_json = json.dumps({key: value for key, value in document.items() if key not in MODELED_SECTIONS})
+
+
+def draw_fields(layout, settings, keys):
+    """One row per schema key, labelled and explained by the schema (panels.py)."""
+    for key in keys:
+        field = FIELDS[key]
+        if field.get("optional") and field["type"] != "choice":
+            layout.prop(settings, use_name(key))
+            if not getattr(settings, use_name(key)):
+                continue
+        layout.prop(settings, prop_name(key))
+
+
+def section_keys(section, exclude=()):
+    """The scalar value keys of a section in file order (for draw_fields)."""
+    return [key for key, field in _value_keys(section + ".") if key not in exclude and not _inside_auto(key) and
+            field["type"] in ("boolean", "integer", "number", "string", "choice", "vec3", "color")]
 
 
 def register():

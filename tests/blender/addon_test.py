@@ -10,6 +10,8 @@ folders the runner (run_blender.cmake) points BLENDER_USER_* at, then runs its c
 
   library       the library loads and its version is checked; a missing or mismatched one is explained
   cache         the cache folder is outside the add-on's folder
+  schema        every property built from the core's schema: keys, defaults, ranges and choices as the
+                library loaded says (dqj_params_schema_json), and a fresh object's document is the default
   parameters    a new object holds the core's defaults; the core validates every change
   presets       presets, import/export round trips of every example, a bad file
   slice         the Python slice against the core's
@@ -51,7 +53,7 @@ OSL_BAKE_RESOLUTION = 160
 MESH_VOLUME_IOU = 0.90        # baked mesh against baked volume (measured 0.95 in 4.2 - 5.0)
 OSL_VOLUME_IOU = 0.95         # OSL volume against baked volume (the same density, computed twice)
 
-CASES = ["library", "cache", "parameters", "presets", "slice", "keyframes", "bake_volume", "bake_mesh",
+CASES = ["library", "cache", "schema", "parameters", "presets", "slice", "keyframes", "bake_volume", "bake_mesh",
          "bake_sequence", "cancel", "render", "osl", "disable"]
 
 
@@ -288,6 +290,102 @@ def case_cache():
         check(default_root.startswith(bpy.utils.user_resource("EXTENSIONS")),
               "an extension's default cache is its extension user folder")
     check(bakes.cache_root() == os.path.abspath(CACHE), "the preferences' cache folder is used")
+
+
+def _float32(value):
+    return array.array("f", [value])[0]
+
+
+def _same(a, b):
+    """Equal as Blender stores them (single precision; ints and bools as numbers)."""
+    if isinstance(a, (list, tuple)) or isinstance(b, (list, tuple)):
+        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
+    if isinstance(a, str) or isinstance(b, str):
+        return a == b
+    return _float32(float(a)) == _float32(float(b))
+
+
+def _near_limit(blender, core, exclusive, inward):
+    """Blender's limit is the core's: equal (single precision; past 3e38 Blender's largest float), or
+    for an exclusive limit just inside it (by at most a thousandth)."""
+    core = max(-3.0e38, min(3.0e38, core))
+    tolerance = 1e-6 * max(1.0, abs(core))
+    if exclusive:
+        return 0 < (blender - core) * inward <= 1e-3 + tolerance
+    return abs(blender - core) <= tolerance
+
+
+def case_schema():
+    with native.Context() as context:
+        library_schema = context.schema()
+    check(library_schema == props.SCHEMA, "the add-on's schema.json is the loaded library's (%d keys)"
+          % len(library_schema["fields"]))
+    # Every key of the core's schema against the property the add-on built for it, read from
+    # Blender's own description of the registered property (bl_rna), not from props.py.
+    groups = {"": bpy.types.Object.bl_rna.properties["dqjulia"].fixed_type,
+              "lights[].": props.DQJLight.bl_rna, "slice.rotations[].": props.DQJRotation.bl_rna,
+              "material.palette[]": props.DQJColor.bl_rna}
+    mapped = 0
+    for field in library_schema["fields"]:
+        key, kind = field["key"], field["type"]
+        if kind in ("object", "list", "color_list", "animation", "axes", "axis_pair"):
+            continue
+        prefix = next((p for p in groups if p and key.startswith(p)), "")
+        rna = groups[prefix].properties
+        names = ([props.prop_name(key) + "_a", props.prop_name(key) + "_b"] if kind == "dual_quaternion"
+                 else [props.prop_name(key)])
+        for index, name in enumerate(names):
+            if not check(name in rna, "%s has its property %s" % (key, name)):
+                continue
+            prop = rna[name]
+            default = field.get("default")
+            if default is None or default == "auto":
+                default = field.get("initial", default)
+            if kind == "dual_quaternion":
+                default = default[4 * index:4 * index + 4]
+            if kind in ("vec3", "color", "vec8", "dual_quaternion"):
+                got = list(prop.default_array)
+            elif kind == "choice_set":
+                got, default = sorted(prop.default_flag), sorted(default)
+            elif kind == "choice":
+                got = prop.default
+                default = field["default"] or "AUTO"  # an optional choice: "Automatic" (absent)
+                names_core = [choice["name"] for choice in field["choices"]]
+                names_blender = [item.identifier for item in prop.enum_items if item.identifier != "AUTO"]
+                check(names_core == names_blender, "%s: the choices are the core's %s" % (key, names_core))
+            else:
+                got = prop.default
+            check(_same(got, default), "%s: the default %r is the core's %r" % (key, got, default))
+            check(prop.name == field["label"] or kind == "dual_quaternion", "%s: labelled %r" % (key, field["label"]))
+            if "min" in field and kind in ("integer", "number", "vec3", "color", "vec8", "dual_quaternion"):
+                check(_near_limit(prop.hard_min, field["min"], field.get("min_exclusive"), 1) and
+                      _near_limit(prop.hard_max, field["max"], field.get("max_exclusive"), -1),
+                      "%s: the range [%g, %g] is the core's [%g, %g]%s" % (
+                          key, prop.hard_min, prop.hard_max, field["min"], field["max"],
+                          " (exclusive limits just inside)" if "min_exclusive" in field or "max_exclusive" in field
+                          else ""))
+            mapped += 1
+    check(mapped >= 45, "%d keys of the schema checked against their properties" % mapped)
+    clear_scene()
+    obj = new_dqjulia()
+    fresh = bpy.data.objects.new("fresh", None)
+    bpy.context.scene.collection.objects.link(fresh)
+    with native.Context() as context:
+        context.set_params(props.to_document(fresh.dqjulia))
+        unset = context.params()
+    defaults = core_document()
+    # Blender's collections start empty (Add DQ Julia fills the lights and palette from the core).
+    for document in (unset, defaults):
+        document.pop("lights")
+        document["material"].pop("palette")
+    differences = ["%s.%s" % (section, key) for section in defaults if isinstance(defaults[section], dict)
+                   for key in defaults[section] if unset.get(section, {}).get(key) != defaults[section][key]]
+    if unset != defaults:
+        report("properties: %s\ncore:       %s" % (json.dumps(unset, sort_keys=True), json.dumps(defaults, sort_keys=True)))
+    check(unset == defaults, "the properties' own defaults (an object never set from the core) are the core's "
+          "document, every key but the lists%s" % (": differ at %s" % differences if differences else ""))
+    check(obj.dqjulia.bake_resolution == defaults["bake"]["resolution"], "bake resolution %d is the core's %d"
+          % (obj.dqjulia.bake_resolution, defaults["bake"]["resolution"]))
 
 
 def case_parameters():
