@@ -37,12 +37,7 @@ protected:
         std::ofstream(dir_ / name) << text;
         return path(name);
     }
-    std::vector<std::string> files() const {
-        std::vector<std::string> names;
-        for (const auto& entry : fs::directory_iterator(dir_)) names.push_back(entry.path().filename().string());
-        std::sort(names.begin(), names.end());
-        return names;
-    }
+    std::vector<std::string> files() const { return dqj::test::fileNames(dir_); }
 
     fs::path dir_;
 };

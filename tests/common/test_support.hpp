@@ -1,6 +1,7 @@
-// test_support.hpp - helpers the GoogleTest suites share: a scratch folder per test, a small
-// tmpfs (a disk that fills up), reading a file whole, running a command and capturing its output, and starting a program in the
-// background (for the interrupt tests).
+// test_support.hpp - helpers the GoogleTest suites share: a scratch folder per test and the
+// names of the files in it, a small tmpfs (a disk that fills up), reading a file whole, running
+// a command and capturing its output, starting a program in the background (for the interrupt
+// tests), and random numbers that are the same on every platform.
 #pragma once
 #include <fcntl.h>
 #include <gtest/gtest.h>
@@ -10,12 +11,17 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
 
 extern char** environ;
 
@@ -104,5 +110,44 @@ inline pid_t spawnProgram(const std::string& program, const std::vector<std::str
     posix_spawn_file_actions_destroy(&actions);
     return status == 0 ? pid : -1;
 }
+
+/// The names of the files in a folder, sorted.
+inline std::vector<std::string> fileNames(const std::filesystem::path& folder) {
+    std::vector<std::string> names;
+    for (const auto& entry : std::filesystem::directory_iterator(folder)) names.push_back(entry.path().filename().string());
+    std::sort(names.begin(), names.end());
+    return names;
+}
+
+/// mt19937_64 is specified exactly by the standard, its distributions are not: the bits are
+/// mapped here, so every platform tests the same points.
+class Random {
+public:
+    explicit Random(std::uint64_t seed) : engine_(seed) {}
+    double uniform(double low, double high) {
+        return low + (high - low) * static_cast<double>(engine_() >> 11) * 0x1.0p-53;
+    }
+    template <typename Count>
+    Count index(Count count) {
+        return static_cast<Count>(engine_() % static_cast<std::uint64_t>(count));
+    }
+    glm::dvec3 inUnitBall() {
+        while (true) {
+            const glm::dvec3 v(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
+            if (glm::dot(v, v) <= 1.0) return v;
+        }
+    }
+    /// A direction, uniform on the sphere (from the ball, away from its centre).
+    glm::dvec3 unitVector() {
+        while (true) {
+            const glm::dvec3 v = inUnitBall();
+            const double length = glm::length(v);
+            if (length > 0.1) return v / length;
+        }
+    }
+
+private:
+    std::mt19937_64 engine_;
+};
 
 }  // namespace dqj::test

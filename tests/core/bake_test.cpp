@@ -35,12 +35,7 @@ protected:
     void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_bake"); }
     void TearDown() override { fs::remove_all(dir_); }
     std::string path(const std::string& name) const { return (dir_ / name).string(); }
-    std::vector<std::string> files() const {
-        std::vector<std::string> names;
-        for (const auto& entry : fs::directory_iterator(dir_)) names.push_back(entry.path().filename().string());
-        std::sort(names.begin(), names.end());
-        return names;
-    }
+    std::vector<std::string> files() const { return dqj::test::fileNames(dir_); }
     fs::path dir_;
 };
 

@@ -32,6 +32,7 @@
 
 #include "dqjulia/estimate.hpp"
 #include "dqjulia/slice.hpp"
+#include "test_support.hpp"
 
 namespace {
 
@@ -46,31 +47,7 @@ constexpr int kUniformPoints = 400;     // outside points anywhere within radius
 constexpr int kFarPoints = 100;         // per far radius
 constexpr int kTestedIterations[] = {30, 40, 50};
 
-/// mt19937_64 is specified exactly; the standard distributions are not, so map bits ourselves.
-class Random {
-public:
-    explicit Random(std::uint64_t seed) : engine_(seed) {}
-    double uniform(double low, double high) {
-        return low + (high - low) * static_cast<double>(engine_() >> 11) * 0x1.0p-53;
-    }
-    std::size_t index(std::size_t count) { return static_cast<std::size_t>(engine_() % count); }
-    glm::dvec3 inUnitBall() {
-        while (true) {
-            const glm::dvec3 v(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
-            if (glm::dot(v, v) <= 1.0) return v;
-        }
-    }
-    glm::dvec3 unitVector() {
-        while (true) {
-            const glm::dvec3 v = inUnitBall();
-            const double length = glm::length(v);
-            if (length > 0.1) return v / length;
-        }
-    }
-
-private:
-    std::mt19937_64 engine_;
-};
+using dqj::test::Random;
 
 /// Runs work(index) for index in [0, count) on all cores.
 void parallelFor(std::size_t count, const std::function<void(std::size_t)>& work) {

@@ -13,6 +13,7 @@
 
 #include "dqjulia/estimate.hpp"
 #include "dqjulia/slice.hpp"
+#include "test_support.hpp"
 
 namespace {
 
@@ -35,25 +36,7 @@ double dot(const Vec8& u, const Vec8& v) {
     return sum;
 }
 
-/// mt19937_64 is specified exactly; the standard distributions are not, so map bits ourselves.
-class Random {
-public:
-    explicit Random(std::uint64_t seed) : engine_(seed) {}
-    double uniform(double low, double high) {
-        return low + (high - low) * static_cast<double>(engine_() >> 11) * 0x1.0p-53;
-    }
-    int index(int count) { return static_cast<int>(engine_() % static_cast<std::uint64_t>(count)); }
-    glm::dvec3 unitVector() {
-        while (true) {
-            const glm::dvec3 v(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
-            const double length = glm::length(v);
-            if (length > 0.1 && length <= 1.0) return v / length;
-        }
-    }
-
-private:
-    std::mt19937_64 engine_;
-};
+using dqj::test::Random;
 
 std::vector<dqj::PlaneRotation> randomRotations(Random& random, int count) {
     std::vector<dqj::PlaneRotation> rotations;

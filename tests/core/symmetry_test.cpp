@@ -14,6 +14,7 @@
 
 #include "dqjulia/algebra.hpp"
 #include "dqjulia/estimate.hpp"
+#include "test_support.hpp"
 
 namespace {
 
@@ -29,31 +30,15 @@ const DualQuat kC2{makeQuat(-0.39054, -0.58679, 0.0, 0.0), makeQuat(0.0, 0.5632,
 constexpr Variant kVariants[] = {Variant::Paper, Variant::PaperCoupled, Variant::Dual};
 constexpr int kPointsPerFractal = 400;
 
-/// mt19937_64 is fully specified by the standard, the distributions are not: map bits ourselves
-/// so every platform tests the same points.
-class Random {
-public:
-    explicit Random(std::uint64_t seed) : engine_(seed) {}
-    double uniform(double low, double high) {
-        return low + (high - low) * static_cast<double>(engine_() >> 11) * 0x1.0p-53;
-    }
-    Quat inBall(double radius) {
-        while (true) {
-            const Quat q = makeQuat(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
-            if (dqj::dot4(q, q) <= 1.0) return q * radius;
-        }
-    }
-    glm::dvec3 unitVector() {
-        while (true) {
-            const glm::dvec3 v(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
-            const double length = glm::length(v);
-            if (length > 0.1 && length <= 1.0) return v / length;
-        }
-    }
+using dqj::test::Random;
 
-private:
-    std::mt19937_64 engine_;
-};
+/// A quaternion uniform in the 4-D ball of `radius`.
+Quat inBall(Random& random, double radius) {
+    while (true) {
+        const Quat q = makeQuat(random.uniform(-1, 1), random.uniform(-1, 1), random.uniform(-1, 1), random.uniform(-1, 1));
+        if (dqj::dot4(q, q) <= 1.0) return q * radius;
+    }
+}
 
 /// A random quaternion constant whose set is connected: its equivalent complex number
 /// c0 + |c_v| i (math.md) keeps the critical orbit bounded. Dust would leave nothing inside.
@@ -186,7 +171,7 @@ TEST(Symmetry, NegationIsBitIdentical) {
     int evaluated = 0;
     for (const Fractal& fractal : testFractals(random)) {
         for (int point = 0; point < kPointsPerFractal; ++point) {
-            const DualQuat z = samplePoint(fractal, point, {random.inBall(1.5), random.inBall(1.5)});
+            const DualQuat z = samplePoint(fractal, point, {inBall(random, 1.5), inBall(random, 1.5)});
             const Escape reference = dqj::evaluate(fractal, z);
             escaped += reference.n != 0;
             ++evaluated;
@@ -241,7 +226,7 @@ TEST(Symmetry, OrthogonalMapsOfImaginaryAxes) {
     Tally reflections;
     for (const Fractal& fractal : testFractals(random)) {
         for (int point = 0; point < kPointsPerFractal; ++point) {
-            const DualQuat z = samplePoint(fractal, point, {random.inBall(1.5), random.inBall(1.5)});
+            const DualQuat z = samplePoint(fractal, point, {inBall(random, 1.5), inBall(random, 1.5)});
             checkOrthogonalMap(randomRotation(random), fractal, z, random, rotations);
             checkOrthogonalMap(randomReflection(random), fractal, z, random, reflections);
         }
@@ -284,7 +269,7 @@ TEST(Symmetry, ConstantInOneIPlaneGivesSolidOfRevolution) {
             for (int point = 0; point < kPointsPerFractal; ++point) {
                 // b0 in the 1-i plane too, so the rotation in the j-k plane fixes it.
                 const DualQuat z = samplePoint(
-                    fractal, point, {random.inBall(1.5), makeQuat(random.uniform(-1, 1), random.uniform(-1, 1), 0, 0)});
+                    fractal, point, {inBall(random, 1.5), makeQuat(random.uniform(-1, 1), random.uniform(-1, 1), 0, 0)});
                 const DualQuat turned{makeQuat(z.a.w, z.a.x, std::hypot(z.a.y, z.a.z), 0.0), z.b};
                 checkRevolution(fractal, z, turned, random, tally);
             }
@@ -306,7 +291,7 @@ TEST(Symmetry, RealConstantGivesSolidOfRevolutionAboutRealAxis) {
             fractal.variant = variant;
             for (int point = 0; point < kPointsPerFractal; ++point) {
                 const DualQuat z =
-                    samplePoint(fractal, point, {random.inBall(1.5), makeQuat(random.uniform(-1, 1), 0, 0, 0)});
+                    samplePoint(fractal, point, {inBall(random, 1.5), makeQuat(random.uniform(-1, 1), 0, 0, 0)});
                 const double vector = std::sqrt(z.a.x * z.a.x + z.a.y * z.a.y + z.a.z * z.a.z);
                 const DualQuat turned{makeQuat(z.a.w, vector, 0.0, 0.0), z.b};
                 checkRevolution(fractal, z, turned, random, tally);
@@ -347,8 +332,8 @@ TEST(SymmetryAlgebra, ComponentOrderMapsToGlmByName) {
 TEST(SymmetryAlgebra, SquareAndSymmetricProductMatchHamiltonProduct) {
     Random random(12345);
     for (int trial = 0; trial < 1000; ++trial) {
-        const Quat a = random.inBall(1.5);
-        const Quat b = random.inBall(1.5);
+        const Quat a = inBall(random, 1.5);
+        const Quat b = inBall(random, 1.5);
         const Quat square = dqj::square(a);
         const Quat product = a * a;  // glm's Hamilton product
         const double squareScale = 1e-15 * std::max(1.0, dqj::dot4(a, a));

@@ -41,9 +41,8 @@ protected:
     }
     std::string path(const std::string& name) const { return "'" + (dir_ / name).string() + "'"; }
     std::set<std::string> filesIn(const fs::path& folder) const {
-        std::set<std::string> names;
-        for (const auto& entry : fs::directory_iterator(folder)) names.insert(entry.path().filename().string());
-        return names;
+        const std::vector<std::string> names = dqj::test::fileNames(folder);
+        return {names.begin(), names.end()};
     }
     void write(const std::string& name, const std::string& text) const { std::ofstream(dir_ / name, std::ios::binary) << text; }
     /// A small tmpfs at dir_/name of `size` (e.g. "64k"), as mount_; false if mounting is not allowed here.

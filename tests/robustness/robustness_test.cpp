@@ -30,11 +30,7 @@ class Scratch : public ::testing::Test {
 protected:
     void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_robust"); }
     void TearDown() override { fs::remove_all(dir_); }
-    std::vector<std::string> filesIn(const fs::path& folder) const {
-        std::vector<std::string> names;
-        for (const auto& entry : fs::directory_iterator(folder)) names.push_back(entry.path().filename().string());
-        return names;
-    }
+    std::vector<std::string> filesIn(const fs::path& folder) const { return dqj::test::fileNames(folder); }
 
     fs::path dir_;
 };
