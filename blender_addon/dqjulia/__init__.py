@@ -29,7 +29,8 @@ class DQJuliaPreferences(bpy.types.AddonPreferences):
 
     cache_dir: StringProperty(
         name="Cache folder", subtype="DIR_PATH", default="",
-        description="Where bakes are written (VDB files). Empty: Blender's user data folder, never the add-on's")
+        description="Where volume bakes are written (VDB files). Empty: beside the .blend, in //dqjulia_cache/ "
+                    "(stored relative, so the project can move); an absolute folder is stored absolute")
 
     def draw(self, context):
         layout = self.layout
@@ -37,7 +38,10 @@ class DQJuliaPreferences(bpy.types.AddonPreferences):
         try:
             layout.label(text="Bakes go to: %s" % bakes.cache_root(context))
         except ValueError as error:
-            layout.label(text=str(error), icon="ERROR")
+            layout.label(text="Bakes go to: %s (beside the .blend once it is saved)" % bakes.chosen_cache(context),
+                         icon="INFO" if not bpy.data.filepath else "ERROR")
+            if bpy.data.filepath:
+                layout.label(text=str(error), icon="ERROR")
         error = native.load_error()
         if error is None:
             layout.label(text="Library: dqjulia %s (%s)" % (native.version()[1], native.library_path()),
@@ -59,9 +63,11 @@ def register():
     panels.register()
     osl.register()
     preview.register()
+    bakes.register()
 
 
 def unregister():
+    bakes.unregister()
     jobs.cancel_all()
     for job in jobs.active_jobs():
         job.join(5.0)

@@ -1,23 +1,38 @@
 """Where bakes go, and the Blender objects made from them (main thread only).
 
-Files go to a cache folder outside the add-on's own folder: the preferences' cache folder if
-set, else Blender's user data folder (4.2+: the extension's user folder). Each bake writes
-new file names and deletes the files of the bake it replaces, so Blender's volume cache never
-shows stale grids. Objects are built only from a finished bake; if building fails, whatever
-was made is removed again, so no half-made object remains.
+Bakes belong to the .blend: by default their files go beside it, into
+//dqjulia_cache/<blend name>/<object>/, and the volumes store that path relative to the .blend,
+so a project folder moved or copied elsewhere renders its own bakes. Volumes need a saved
+.blend (the operators say so); the add-on's preferences may name another cache folder (an
+absolute one is stored absolute, e.g. a farm's shared drive). Blender's External Data tools
+(Make Paths Relative/Absolute, Report/Find Missing Files, Pack Resources for single files)
+work on them as on any file.
+
+A bake never deletes a file a saved .blend may use: a re-bake writes new file names and
+removes the replaced bake's files only if they were made since the .blend was last saved or
+opened (so no saved file can refer to them). Objects are built only from a finished bake; if
+building fails, whatever was made is removed again, so no half-made object remains. A missing
+bake file is reported in the panel and in the render log (missing_bakes).
 """
 
 import array
 import os
 import shutil
+import sys
 import uuid
 
 import bpy
+from bpy.app.handlers import persistent
 
 ADDON_DIR = os.path.dirname(os.path.abspath(__file__))
 BAKE_KIND = "dqjulia_bake"      # custom property on baked objects: "volume", "mesh", "sequence"
-BAKE_FILES = "dqjulia_files"    # custom property: the files or folder the baked object reads
+BAKE_FILES = "dqjulia_files"    # custom property: the files or folder the baked object reads (as stored)
 VOLUME_DENSITY_SCALE = 10.0     # the fog is 0..1; this makes the set read as solid-ish smoke
+DEFAULT_CACHE = "//dqjulia_cache"  # beside the .blend
+
+# The bake files made since the .blend was last saved or opened (absolute, normalised): the
+# only ones a re-bake may delete.
+_made_since_save = set()
 
 
 def _package():
@@ -30,26 +45,36 @@ def preferences(context=None):
     return addon.preferences if addon else None
 
 
-def default_cache_root():
-    """The default cache folder: never inside the add-on's folder."""
-    extension_path_user = getattr(bpy.utils, "extension_path_user", None)
-    if extension_path_user is not None:
-        try:
-            return extension_path_user(_package(), path="cache", create=True)
-        except (ValueError, RuntimeError, TypeError):
-            pass  # a legacy add-on in 4.2+, not an extension
-    return bpy.utils.user_resource("DATAFILES", path="dqjulia_cache", create=True)
+def chosen_cache(context=None):
+    """The cache folder as the user gave it: the preferences' folder, or //dqjulia_cache."""
+    prefs = preferences(context)
+    return (getattr(prefs, "cache_dir", "") if prefs else "") or DEFAULT_CACHE
 
 
 def cache_root(context=None):
-    prefs = preferences(context)
-    chosen = getattr(prefs, "cache_dir", "") if prefs else ""
-    root = bpy.path.abspath(chosen) if chosen else default_cache_root()
-    root = os.path.abspath(root)
+    """The cache folder, absolute. ValueError when it is relative to an unsaved .blend, or
+    inside the add-on's folder (which Blender replaces on updates)."""
+    chosen = chosen_cache(context)
+    if chosen.startswith("//") and not bpy.data.filepath:
+        raise ValueError("save the .blend file first: volume bakes are stored beside it (in %s/), so they travel "
+                         "with the project (or choose an absolute cache folder in the add-on's preferences)" % chosen)
+    root = os.path.abspath(bpy.path.abspath(chosen))
     if os.path.commonpath([root, ADDON_DIR]) == ADDON_DIR:
         raise ValueError("the cache folder %s is inside the add-on's folder, which Blender replaces on updates; "
                          "choose another in the add-on's preferences" % root)
     return root
+
+
+def stored_path(path):
+    """How a bake file's path is stored: relative to the .blend ("//...") when the cache folder
+    was given relative to it, else absolute."""
+    if bpy.data.filepath and chosen_cache().startswith("//"):
+        return bpy.path.relpath(path)
+    return os.path.abspath(path)
+
+
+def _absolute(path):
+    return os.path.normpath(os.path.abspath(bpy.path.abspath(path)))
 
 
 def _safe(name):
@@ -77,6 +102,8 @@ def sequence_frame_path(directory, obj, frame):
 
 def remove_files(paths):
     for path in paths:
+        path = _absolute(path)
+        _made_since_save.discard(path)
         try:
             if os.path.isdir(path):
                 shutil.rmtree(path)
@@ -123,8 +150,11 @@ def _replace(context, source, kind, name, data, files):
             elif isinstance(old_data, bpy.types.Mesh):
                 bpy.data.meshes.remove(old_data)
     obj[BAKE_KIND] = kind
-    obj[BAKE_FILES] = list(files)
-    remove_files([path for path in old_files if path not in files])
+    obj[BAKE_FILES] = [stored_path(path) for path in files]
+    _made_since_save.update(_absolute(path) for path in files)
+    # Only files no saved .blend can refer to (made since the last save or open) are removed.
+    kept = {_absolute(path) for path in files}
+    remove_files([path for path in old_files if _absolute(path) not in kept and _absolute(path) in _made_since_save])
     return obj
 
 
@@ -190,7 +220,7 @@ def build_volume(context, source, path, sequence=None):
     volume = bpy.data.volumes.new(name)
     material = None
     try:
-        volume.filepath = path
+        volume.filepath = stored_path(path)
         if sequence:
             # Blender plays file number (scene frame - frame_start + 1 + frame_offset): with the
             # offset below, file name_0007.vdb is scene frame 7.
@@ -260,3 +290,46 @@ def build_mesh(context, source, data):
             bpy.data.materials.remove(material)
         bpy.data.meshes.remove(mesh)
         raise
+
+
+# -------------------------------------------------------------------------------------------
+# Missing bakes
+
+
+def missing_bakes(objects):
+    """(object, path) for each baked volume among `objects` whose file is not there."""
+    missing = []
+    for obj in objects:
+        if obj.get(BAKE_KIND) in ("volume", "sequence") and obj.type == "VOLUME" and obj.data is not None:
+            if obj.data.packed_file is None and not os.path.isfile(bpy.path.abspath(obj.data.filepath)):
+                missing.append((obj, obj.data.filepath))
+    return missing
+
+
+@persistent
+def _saved_or_opened(*_args):
+    _made_since_save.clear()
+
+
+@persistent
+def _report_missing_at_render(scene, *_args):
+    """Render log: a baked volume whose file is missing renders empty; say so."""
+    for obj, path in missing_bakes(scene.objects):
+        print("dqjulia: WARNING: %s renders empty: its bake file %s (%s) is missing; bake it again, or find it "
+              "with File > External Data > Find Missing Files" % (obj.name, path, bpy.path.abspath(path)),
+              file=sys.stderr, flush=True)
+
+
+_HANDLERS = (("save_post", _saved_or_opened), ("load_post", _saved_or_opened), ("render_init", _report_missing_at_render))
+
+
+def register():
+    for name, handler in _HANDLERS:
+        getattr(bpy.app.handlers, name).append(handler)
+
+
+def unregister():
+    for name, handler in _HANDLERS:
+        handlers = getattr(bpy.app.handlers, name)
+        if handler in handlers:
+            handlers.remove(handler)

@@ -8,7 +8,7 @@ import time
 
 import bpy
 
-from . import jobs, native, operators, osl, preview, props
+from . import bakes, jobs, native, operators, osl, preview, props
 
 
 def _wrapped(layout, text, icon="NONE", alert=False, width=56):
@@ -207,6 +207,14 @@ class _BakePanel(_Base):
         if native.load_error() is None and not native.has("dqj_bake_vdb"):
             _wrapped(layout, "This dqjulia library cannot bake (built without OpenVDB baking).", icon="ERROR",
                      alert=True)
+        for baked, path in bakes.missing_bakes(obj.children):
+            _wrapped(layout.box(), "%s renders empty: its bake file %s is missing. Bake again, or find it with "
+                                   "File > External Data > Find Missing Files." % (baked.name, path),
+                     icon="ERROR", alert=True)
+        try:
+            bakes.cache_root(context)
+        except ValueError as error:
+            _wrapped(layout, "Volumes: " + str(error), icon="INFO")
         column = layout.column(align=True)
         column.operator(operators.DQJULIA_OT_bake_volume.bl_idname, icon="OUTLINER_OB_VOLUME")
         column.operator(operators.DQJULIA_OT_bake_mesh.bl_idname, icon="MESH_ICOSPHERE")

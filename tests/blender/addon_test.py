@@ -9,7 +9,9 @@ zip as a user would (an extension in 4.2+, the legacy add-on in 3.4 - 4.1) into 
 folders the runner (run_blender.cmake) points BLENDER_USER_* at, then runs its case:
 
   library       the library loads and its version is checked; a missing or mismatched one is explained
-  cache         the cache folder is outside the add-on's folder
+  cache         bakes go beside the .blend (//dqjulia_cache), never into the add-on's folder
+  save_as       Save As then re-bake keeps the first file's bake; unsaved bakes only are removed
+  moved_project a moved project renders its volume from the new place; a missing file is reported
   schema        every property built from the core's schema: keys, defaults, ranges and choices as the
                 library loaded says (dqj_params_schema_json), and a fresh object's document is the default
   parameters    a new object holds the core's defaults; the core validates every change
@@ -30,8 +32,10 @@ never run, so the threaded path is exercised through jobs.Job directly (case can
 """
 
 import array
+import io
 import json
 import os
+import shutil
 import sys
 import time
 
@@ -53,7 +57,7 @@ OSL_BAKE_RESOLUTION = 160
 MESH_VOLUME_IOU = 0.90        # baked mesh against baked volume (measured 0.95 in 4.2 - 5.0)
 OSL_VOLUME_IOU = 0.95         # OSL volume against baked volume (the same density, computed twice)
 
-CASES = ["library", "cache", "schema", "parameters", "presets", "slice", "keyframes", "bake_volume", "bake_mesh",
+CASES = ["library", "cache", "save_as", "moved_project", "schema", "parameters", "presets", "slice", "keyframes", "bake_volume", "bake_mesh",
          "bake_sequence", "cancel", "render", "osl", "disable"]
 
 
@@ -283,13 +287,128 @@ def case_library():
 
 
 def case_cache():
-    default_root = bakes.default_cache_root()
-    check(os.path.commonpath([os.path.abspath(default_root), ADDON_DIR]) != ADDON_DIR,
-          "the default cache folder %s is outside the add-on's folder" % default_root)
-    if common.uses_extensions():
-        check(default_root.startswith(bpy.utils.user_resource("EXTENSIONS")),
-              "an extension's default cache is its extension user folder")
     check(bakes.cache_root() == os.path.abspath(CACHE), "the preferences' cache folder is used")
+    with DefaultCache():
+        check(bakes.chosen_cache() == "//dqjulia_cache", "by default bakes go beside the .blend (//dqjulia_cache)")
+        if not bpy.data.filepath:
+            try:
+                bakes.cache_root()
+                check(False, "an unsaved .blend has no cache folder")
+            except ValueError as error:
+                check("save the .blend" in str(error), "an unsaved .blend is told to save first: %s" % str(error)[:80])
+        blend = os.path.join(ARGS.work, "cache-test", "scene.blend")
+        os.makedirs(os.path.dirname(blend), exist_ok=True)
+        bpy.ops.wm.save_as_mainfile(filepath=blend)
+        root = bakes.cache_root()
+        check(root == os.path.join(os.path.dirname(blend), "dqjulia_cache"), "saved: the cache is beside it: %s" % root)
+        check(os.path.commonpath([root, ADDON_DIR]) != ADDON_DIR, "and outside the add-on's folder")
+
+
+class DefaultCache:
+    """The add-on's default cache (beside the .blend) for the time of a with block; the tests'
+    own cache folder again afterwards."""
+
+    def __enter__(self):
+        bakes.preferences().cache_dir = ""
+
+    def __exit__(self, *_exc):
+        bakes.preferences().cache_dir = CACHE
+
+
+def _bake_volume_of(name):
+    obj = bpy.data.objects[name]
+    make_active(obj)
+    result, error = common.call(bpy.ops.dqjulia.bake_volume, synchronous=True)
+    check(result == {"FINISHED"}, "Bake Volume %s%s" % (name, ": " + error if error else ""))
+    return baked_child(obj, "volume")
+
+
+def case_save_as():
+    """Save v01, bake, save; Save As v02, change, bake: v01's bake is kept (the reported data loss)."""
+    folder = os.path.join(ARGS.work, "project")
+    os.makedirs(folder, exist_ok=True)
+    with DefaultCache():
+        clear_scene()
+        obj = new_dqjulia()
+        obj.name = "Julia"
+        obj.dqjulia.bake_resolution = 32
+        if not bpy.data.filepath:
+            result, error = common.call(bpy.ops.dqjulia.bake_volume, synchronous=True)
+            check(result == {"CANCELLED"} and "save the .blend" in error,
+                  "before the first save a volume bake asks to save first: %s" % error[:90])
+        v01 = os.path.join(folder, "v01.blend")
+        bpy.ops.wm.save_as_mainfile(filepath=v01)
+        volume = _bake_volume_of("Julia")
+        stored = volume.data.filepath
+        first = bpy.path.abspath(stored)
+        check(stored.startswith("//dqjulia_cache/v01/Julia/") and os.path.isfile(first),
+              "the bake is beside the .blend, stored relative: %s" % stored)
+        bpy.ops.wm.save_mainfile()
+        v02 = os.path.join(folder, "v02.blend")
+        bpy.ops.wm.save_as_mainfile(filepath=v02)
+        bpy.data.objects["Julia"].dqjulia.iterations = 10
+        volume = _bake_volume_of("Julia")
+        second = bpy.path.abspath(volume.data.filepath)
+        check(volume.data.filepath.startswith("//dqjulia_cache/v02/Julia/") and os.path.isfile(second),
+              "after Save As the new bake goes to v02's folder: %s" % volume.data.filepath)
+        check(os.path.isfile(first), "v01's bake is kept (v01.blend refers to it)")
+        volume = _bake_volume_of("Julia")
+        third = bpy.path.abspath(volume.data.filepath)
+        check(os.path.isfile(third) and not os.path.exists(second) and os.path.isfile(first),
+              "a re-bake before saving removes only the unsaved bake it replaces")
+        bpy.ops.wm.save_mainfile()
+        bpy.ops.wm.open_mainfile(filepath=v01)
+        volume = baked_child(bpy.data.objects["Julia"], "volume")
+        check(volume is not None and bpy.path.abspath(volume.data.filepath) == first and volume.data.grids.load(),
+              "v01.blend opens with its own bake, which loads")
+        check(not bakes.missing_bakes(bpy.data.objects), "and nothing is reported missing")
+        bpy.ops.wm.open_mainfile(filepath=v02)
+        volume = baked_child(bpy.data.objects["Julia"], "volume")
+        check(bpy.path.abspath(volume.data.filepath) == third and volume.data.grids.load(), "v02.blend has its last bake")
+        clear_scene()
+
+
+def case_moved_project():
+    """A project folder moved elsewhere renders its volume from the new place."""
+    folder = os.path.join(ARGS.work, "before", "project")
+    os.makedirs(folder, exist_ok=True)
+    with DefaultCache():
+        clear_scene()
+        obj = new_dqjulia()
+        obj.name = "Julia"
+        obj.dqjulia.bake_resolution = RENDER_BAKE_RESOLUTION
+        blend = os.path.join(folder, "scene.blend")
+        bpy.ops.wm.save_as_mainfile(filepath=blend)
+        _bake_volume_of("Julia")
+        bpy.ops.wm.save_mainfile()
+        moved = os.path.join(ARGS.work, "after", "renamed project")
+        os.makedirs(os.path.dirname(moved), exist_ok=True)
+        shutil.move(folder, moved)
+        check(not os.path.exists(folder), "the project folder was moved away (nothing left to read at the old place)")
+        bpy.ops.wm.open_mainfile(filepath=os.path.join(moved, "scene.blend"))
+        source = bpy.data.objects["Julia"]
+        volume = baked_child(source, "volume")
+        path = bpy.path.abspath(volume.data.filepath)
+        check(path.startswith(moved + os.sep) and os.path.isfile(path), "the volume reads the moved file: %s" % path)
+        scene = bpy.context.scene
+        setup_cycles(scene)
+        camera_on(scene, source)
+        alpha, _seconds = render_alpha(scene, [volume], "moved-project")
+        silhouette(alpha, "moved project's volume")
+
+        report("== a missing bake file is reported in the panel's check and the render log")
+        os.remove(path)
+        check([item[0].name for item in bakes.missing_bakes(source.children)] == [volume.name],
+              "the missing file is found (the panel shows it)")
+        log = io.StringIO()
+        saved, sys.stderr = sys.stderr, log
+        try:
+            render_alpha(scene, [volume], "missing-bake")
+        finally:
+            sys.stderr = saved
+        check("renders empty" in log.getvalue() and volume.name in log.getvalue(),
+              "the render log says so: %r" % log.getvalue().strip()[:140])
+        clear_scene()
 
 
 def _float32(value):
