@@ -81,6 +81,23 @@ class MeshTask:
                         _as_array("i", triangles))
 
 
+def format_duration(seconds):
+    """12 s, 4 min, 2.5 h."""
+    if seconds < 90:
+        return "%d s" % max(1, round(seconds))
+    if seconds < 5400:
+        return "%d min" % round(seconds / 60.0)
+    return "%.1f h" % (seconds / 3600.0)
+
+
+def format_bytes(count):
+    for unit in ("bytes", "KB", "MB", "GB"):
+        if count < 1000 or unit == "GB":
+            return ("%d %s" if unit == "bytes" else "%.1f %s") % (count, unit)
+        count /= 1000.0
+    return "%.1f TB" % count
+
+
 class Job:
     """Tasks run in order in one worker thread (or synchronously with run())."""
 
@@ -114,8 +131,24 @@ class Job:
         self._task_fraction = fraction
 
     def status_text(self):
-        part = " %d/%d" % (self.index + 1, len(self.tasks)) if len(self.tasks) > 1 else ""
-        return "%s%s: %d%%" % (self.label, part, round(100.0 * self.fraction))
+        """"Bake sequence: 12 of 250 frames done, 4% (about 23 min left)"."""
+        text = "%s: %d%%" % (self.label, round(100.0 * self.fraction))
+        if len(self.tasks) > 1:
+            text = "%s: %d of %d %s done, %d%%" % (self.label, min(self.index, len(self.tasks)), len(self.tasks),
+                                                  "frames" if self.tasks[0].kind == "volume" else "parts",
+                                                  round(100.0 * self.fraction))
+        left = self.seconds_left()
+        if left is not None:
+            text += " (about %s left)" % format_duration(left)
+        return text
+
+    def seconds_left(self):
+        """The time left at the pace so far; None until there is a pace to go by."""
+        fraction = self.fraction
+        elapsed = time.monotonic() - self.started
+        if fraction < 0.02 or elapsed < 2.0 or fraction >= 1.0:
+            return None
+        return elapsed * (1.0 - fraction) / fraction
 
     # control -------------------------------------------------------------------------------
 

@@ -7,8 +7,11 @@ synchronously with `synchronous=True` (automatic in background mode, where there
 events); the objects are built the same way in both paths.
 """
 
+import json
+import math
 import os
 import tempfile
+import time
 
 import bpy
 from bpy.props import BoolProperty, EnumProperty, StringProperty
@@ -413,10 +416,69 @@ class DQJULIA_OT_bake_mesh(_BakeOperator, bpy.types.Operator):
         return "Baked %s: %d vertices, %d triangles" % (mesh.name, data.vertex_count, data.triangle_count)
 
 
+def estimate_sequence(document, frames, folder):
+    """(bytes, seconds) a sequence bake of `frames` frames of `document` will take, from sample
+    bakes of its first frame at two small resolutions (the cost grows between the square and the
+    cube of the resolution: the fitted power, kept in [2, 3], carries it to the full one)."""
+    resolution = document["bake"]["resolution"]
+    samples = sorted({min(resolution, 24), min(resolution, 48)})
+    measured = []
+    os.makedirs(folder, exist_ok=True)
+    with native.Context() as context:
+        for index, sample in enumerate(samples):
+            probe = json.loads(json.dumps(document))
+            probe["bake"]["resolution"] = sample
+            context.set_params(probe)
+            path = os.path.join(folder, "estimate-%d.vdb" % index)
+            started = time.monotonic()
+            try:
+                context.bake_vdb(path)
+                measured.append((sample, os.path.getsize(path), time.monotonic() - started))
+            finally:
+                bakes.remove_files([path])
+    if len(measured) == 1:
+        _sample, size, seconds = measured[0]
+        return size * len(frames), seconds * len(frames)
+    (r1, s1, t1), (r2, s2, t2) = measured
+    scale = resolution / r2
+
+    def extrapolate(low, high):
+        power = max(2.0, min(3.0, math.log(max(high, 1e-9) / max(low, 1e-9)) / math.log(r2 / r1)))
+        return high * scale ** power
+
+    return extrapolate(s1, s2) * len(frames), extrapolate(t1, t2) * len(frames)
+
+
 class DQJULIA_OT_bake_sequence(_BakeOperator, bpy.types.Operator):
     """Bake a volume for every frame of the scene's frame range (the keyframed values of each frame) and add a Volume object that plays them back"""
     bl_idname = "dqjulia.bake_sequence"
     bl_label = "Bake Sequence"
+
+    _estimate = ""
+
+    def invoke(self, context, _event):
+        """Asks first: the frame count, and the disk space and time a quick sample predicts."""
+        obj = dqjulia_object(context)
+        scene = context.scene
+        frames = list(range(scene.frame_start, scene.frame_end + 1))
+        if context.window is None or not frames or obj is None:
+            return self.execute(context)
+        try:
+            folder = os.path.join(bakes.cache_root(context), ".estimate")
+            size, seconds = estimate_sequence(_bake_document(obj, need_density=True), frames, folder)
+        except (native.NativeError, native.NativeUnavailable, ValueError, OSError) as error:
+            self.report({"ERROR"}, str(error))
+            return {"CANCELLED"}
+        self._estimate = "%d frames (%d-%d) at %d voxels: about %s on disk and %s" % (
+            len(frames), frames[0], frames[-1], obj.dqjulia.bake_resolution, jobs.format_bytes(size),
+            jobs.format_duration(seconds))
+        return context.window_manager.invoke_props_dialog(self, width=420)
+
+    def draw(self, _context):
+        layout = self.layout
+        layout.label(text="Bake a volume for every frame?", icon="QUESTION")
+        layout.label(text=self._estimate)
+        layout.label(text="(estimated from sample bakes of the first frame)")
 
     def make_job(self, context, obj):
         scene = context.scene

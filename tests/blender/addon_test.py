@@ -726,6 +726,23 @@ def case_bake_sequence():
         sizes.append(os.path.getsize(grids.frame_filepath))
     check(len(set(sizes)) > 1, "the frames differ (keyframed iterations and rotation): sizes %s" % sizes)
 
+    report("== the estimate Bake Sequence shows before it starts")
+    operators = operators_module()
+    document = operators._bake_document(obj, need_density=True)
+    size, seconds = operators.estimate_sequence(document, [1, 2, 3], os.path.join(ARGS.work, "estimate"))
+    check(0.5 * sum(sizes) < size < 2.0 * sum(sizes) and seconds > 0,
+          "3 frames at 40: about %s and %s (the files hold %s)" % (
+              jobs.format_bytes(size), jobs.format_duration(seconds), jobs.format_bytes(sum(sizes))))
+    check(not os.listdir(os.path.join(ARGS.work, "estimate")), "the sample bakes leave no file")
+    document["bake"]["resolution"] = 160
+    big, slow = operators.estimate_sequence(document, list(range(1, 251)), os.path.join(ARGS.work, "estimate"))
+    check(big > 40 * size and slow > 40 * seconds, "250 frames at 160 cost far more: %s, %s"
+          % (jobs.format_bytes(big), jobs.format_duration(slow)))
+    job = jobs.Job("Bake sequence", [jobs.VolumeTask(document, "a"), jobs.VolumeTask(document, "b")])
+    job.index, job.started = 1, time.monotonic() - 10.0
+    check(job.status_text().startswith("Bake sequence: 1 of 2 frames done, 50%") and "left" in job.status_text(),
+          "the progress says frames done and time left: %r" % job.status_text())
+
 
 def case_cancel():
     clear_scene()
