@@ -11,12 +11,26 @@ import bpy
 from . import bakes, jobs, native, operators, osl, preview, props
 
 
-def _wrapped(layout, text, icon="NONE", alert=False, width=56):
+def _wrapped(layout, text, icon="NONE", alert=False, width=None):
+    """A text in lines that fit the panel: as many characters a line as its region is wide
+    (about 7 pixels a character at the default UI scale), so nothing is cut off."""
+    if width is None:
+        region = getattr(bpy.context, "region", None)
+        scale = bpy.context.preferences.system.ui_scale if bpy.context.preferences else 1.0
+        width = max(20, int((region.width if region else 400) / (7.0 * scale)) - 6)
     column = layout.column(align=True)
     column.alert = alert
     lines = textwrap.wrap(text, width) or [""]
     for index, line in enumerate(lines):
         column.label(text=line, icon=icon if index == 0 else "BLANK1")
+
+
+def _quaternion_row(layout, settings, name, label):
+    """One labelled row of a quaternion's four components: "a  s [ ] i [ ] j [ ] k [ ]"."""
+    row = layout.row(align=True)
+    row.label(text=label)
+    for index, component in enumerate("sijk"):
+        row.prop(settings, name, index=index, text=component)
 
 
 class DQJULIA_MT_presets(bpy.types.Menu):
@@ -85,12 +99,10 @@ class _MainPanel:
         column.prop(s, "variant")
         column.prop(s, "iterations")
         column.prop(s, "bailout")
-        column.label(text="Constant c = a + b eps (s, i, j, k):")
-        split = column.split(factor=0.5, align=True)
-        for name in ("c_a", "c_b"):
-            part = split.column(align=True)
-            part.label(text="a (real)" if name == "c_a" else "b (dual)")
-            part.prop(s, name, text="")
+        column.label(text="Constant c = a + b\u03b5:")
+        constant = column.column(align=True)
+        _quaternion_row(constant, s, "c_a", "a")
+        _quaternion_row(constant, s, "c_b", "b")
 
         state = preview.state_for(obj)
         if state.error:
@@ -243,13 +255,15 @@ class _OslPanel(_Base):
 
 
 class _ShadingPanel(_Base):
-    bl_label = "Shading, Camera and Render (core)"
+    """The material and lights the preview shades with (and the core's renderer). The settings
+    only `dqjulia render` uses (camera, image size, samples, output: the schema's image_only
+    keys) are not shown; they stay in the object and in the exported parameter file."""
+    bl_label = "Shading"
     bl_options = {"DEFAULT_CLOSED"}
 
     def draw(self, context):
         s = operators.dqjulia_object(context).dqjulia
         layout = self.layout
-        layout.label(text="Used by the core's renderer (dqjulia render) and the preview.")
         column = layout.column()
         column.prop(s, "coloring")
         column.prop(s, "color")
@@ -261,7 +275,8 @@ class _ShadingPanel(_Base):
         remove.collection, remove.action = "palette", "REMOVE"
         for entry in s.palette:
             column.prop(entry, "color", text="")
-        props.draw_fields(column, s, props.section_keys("material", exclude=("material.color", "material.coloring")))
+        props.draw_fields(column, s, [key for key in props.section_keys(
+            "material", exclude=("material.color", "material.coloring")) if not props.FIELDS[key].get("image_only")])
         row = column.row()
         row.label(text="Lights")
         add = row.operator(operators.DQJULIA_OT_collection_edit.bl_idname, text="", icon="ADD")
@@ -274,15 +289,7 @@ class _ShadingPanel(_Base):
             row = box.row()
             row.prop(light, "color", text="")
             row.prop(light, "intensity")
-        column.separator()
-        props.draw_fields(column, s, props.section_keys("camera"))
-        column.separator()
-        row = column.row(align=True)
-        row.prop(s, "width")
-        row.prop(s, "height")
-        props.draw_fields(column, s, props.section_keys("render", exclude=(
-            "render.width", "render.height", "render.step_factor", "render.max_step")))
-        props.draw_fields(column, s, props.section_keys("output") + ["description"])
+        column.prop(s, "description")
 
 
 def _make_panels():

@@ -68,7 +68,7 @@ const Field kFields[] = {
 
     {"slice", Type::Object, "Slice", "The 3-D slice of the 8-D space: x, y, z map to origin + x X + y Y + z Z"},
     {"slice.axes", Type::Axes, "Axes", "Where x, y and z go: axis names \"a.s,a.i,a.j\" or three 8-D vectors", -kHuge,
-     kHuge},
+     kHuge, false, false, -2, 2},
     {"slice.origin", Type::Vec8, "Origin", "The 8-D point at x = y = z = 0 (a's s, i, j, k, then b's)", -kHuge, kHuge,
      false, false, -2, 2},
     {"slice.rotations", Type::List, "Rotations", "Rotations of the axes in planes of the 8-D space, applied in order", 0,
@@ -113,7 +113,7 @@ const Field kFields[] = {
     {"material.specular", Type::Number, "Specular", "k_s, the specular share", 0, 100, false, false, 0, 1},
     {"material.shininess", Type::Number, "Shininess", "The specular exponent s", 0, 10000, false, false, 0, 200},
     {"material.occlusion", Type::Number, "Occlusion", "Strength of ambient occlusion from the distance estimate, 0 = off",
-     0, 1},
+     0, 1, false, false, 0, 1, {}, kImage},
     {"material.shadows", Type::Boolean, "Shadows", "Soft shadows from the distance estimate", 0, 0, false, false, 0, 0,
      {}, kImage},
     {"material.shadow_softness", Type::Number, "Shadow softness", "Penumbra factor k: larger = harder shadows", 0, 1000,
