@@ -114,6 +114,14 @@ class _NeedsDQJuliaObject:
         return dqjulia_object(context) is not None
 
 
+# The one orientation convention: the slice's y is up, as in `dqjulia render`'s pictures, the
+# paper's figures and the files the command writes (OBJ, PLY, VDB: y-up, as Houdini's). Blender
+# is z-up, so a new DQ Julia object is turned +90 degrees about x: its local (x, y, z) = the
+# slice's, and the slice's y lies along Blender's Z. Preview, baked volumes and meshes and the OSL
+# volume all sit in the object's frame, so they share it.
+SLICE_TO_BLENDER_ROTATION = (math.pi / 2.0, 0.0, 0.0)
+
+
 class DQJULIA_OT_add(bpy.types.Operator):
     """Add a DQ Julia object: the set ray-marched in the viewport inside its bounds"""
     bl_idname = "object.dqjulia_add"
@@ -130,6 +138,7 @@ class DQJULIA_OT_add(bpy.types.Operator):
         obj = bpy.data.objects.new("DQ Julia", None)
         obj.empty_display_type = "SPHERE"
         obj.location = context.scene.cursor.location
+        obj.rotation_euler = SLICE_TO_BLENDER_ROTATION
         context.collection.objects.link(obj)
         try:
             obj.dqjulia.enabled = True

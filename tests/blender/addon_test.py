@@ -520,6 +520,11 @@ def case_parameters():
     state = preview.state_for(obj)
     check(state.error is None and state.bounds is not None, "its parameters validate; bounds %s" % (state.bounds,))
     check(abs(obj.empty_display_size - state.bounds[1]) < 1e-5, "the empty shows the bounds' radius")
+    from mathutils import Vector
+    up = obj.matrix_world.to_3x3() @ Vector((0.0, 1.0, 0.0))
+    toward = obj.matrix_world.to_3x3() @ Vector((0.0, 0.0, 1.0))
+    check((up - Vector((0.0, 0.0, 1.0))).length < 1e-6 and (toward - Vector((0.0, -1.0, 0.0))).length < 1e-6,
+          "the slice's y is Blender's Z and its z faces the front view (-Y), as `dqjulia render` shows it")
     obj.dqjulia.bailout = 1.2
     state = preview.state_for(obj)
     check(state.error is not None and "fractal.bailout" in state.error,

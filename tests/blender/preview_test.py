@@ -205,7 +205,9 @@ def step_offscreen_iou(obj):
         s.preview_max_steps = s.max_steps  # the preview marches as far as the core
         document = props.to_document(s)
         expected = core_mask(document, WIDTH, HEIGHT)
-        view = look_at(eye, target, up)
+        # The core's camera is in the slice's (the object's local) coordinates; the viewport's in
+        # the world's: the object is turned (Add DQ Julia's y-up convention).
+        view = look_at(eye, target, up) @ obj.matrix_world.inverted()
         projection = perspective(fov, WIDTH / HEIGHT, 0.05, 100.0)
         drew, _rgba, drawn = offscreen_preview(obj, view, projection, WIDTH, HEIGHT)
         check(drew, "%s: the preview shader compiled and drew (%s)" % (name, preview.shader_error() or "no error"))
@@ -314,7 +316,7 @@ def save_screenshots(obj):
         props.from_document(obj.dqjulia, context.params())
     obj.dqjulia.show_bounds = True
     obj.dqjulia.show_preview = True
-    obj.rotation_euler = (1.5708, 0.0, 0.0)  # the slice's y axis up, as the CLI's camera has it
+    check(abs(obj.rotation_euler[0] - 1.5708) < 1e-4, "the object is turned y-up, as the CLI's camera has it")
     bpy.context.view_layer.objects.active = obj
     obj.select_set(True)
     rv3d = space.region_3d
