@@ -306,6 +306,22 @@ def missing_bakes(objects):
     return missing
 
 
+OSL_SOURCE = "dqjulia_osl_source"  # osl.SOURCE_KEY: an OSL volume's source object
+
+
+def renders_nothing(scene_objects, source):
+    """True when a DQ Julia object has nothing a renderer shows: no baked volume or mesh among
+    its children and no OSL volume (the preview is viewport only)."""
+    if any(child.get(BAKE_KIND) for child in source.children):
+        return False
+    return not any(obj.get(OSL_SOURCE) == source.name for obj in scene_objects)
+
+
+def unrendered_sources(scene):
+    return [obj for obj in scene.objects if getattr(obj, "dqjulia", None) is not None and obj.dqjulia.enabled
+            and not obj.hide_render and renders_nothing(scene.objects, obj)]
+
+
 @persistent
 def _saved_or_opened(*_args):
     _made_since_save.clear()
@@ -317,6 +333,10 @@ def _report_missing_at_render(scene, *_args):
     for obj, path in missing_bakes(scene.objects):
         print("dqjulia: WARNING: %s renders empty: its bake file %s (%s) is missing; bake it again, or find it "
               "with File > External Data > Find Missing Files" % (obj.name, path, bpy.path.abspath(path)),
+              file=sys.stderr, flush=True)
+    for obj in unrendered_sources(scene):
+        print("dqjulia: WARNING: %s renders nothing: the DQ Julia object is drawn in the viewport only; bake a "
+              "volume or a mesh (DQ Julia > Bake), or add an OSL volume (Cycles with OSL)" % obj.name,
               file=sys.stderr, flush=True)
 
 

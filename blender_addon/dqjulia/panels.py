@@ -219,6 +219,10 @@ class _BakePanel(_Base):
         if native.load_error() is None and not native.has("dqj_bake_vdb"):
             _wrapped(layout, "This dqjulia library cannot bake (built without OpenVDB baking).", icon="ERROR",
                      alert=True)
+        if bakes.renders_nothing(context.scene.objects, obj):
+            _wrapped(layout.box(), "Renders (F12) show nothing yet: the preview is for the viewport. Bake a volume "
+                                   "or a mesh here%s." % (", or add an OSL volume below" if osl.available() else
+                                                          " (this Blender has no OSL volume)"), icon="INFO")
         for baked, path in bakes.missing_bakes(obj.children):
             _wrapped(layout.box(), "%s renders empty: its bake file %s is missing. Bake again, or find it with "
                                    "File > External Data > Find Missing Files." % (baked.name, path),

@@ -630,6 +630,17 @@ def case_bake_volume():
     obj = keyed_object()
     make_active(obj)
     bpy.context.scene.frame_set(1)
+    scene = bpy.context.scene
+    check(bakes.unrendered_sources(scene) == [obj], "before a bake the object renders nothing, and the panel and the "
+          "render log say so")
+    log = io.StringIO()
+    saved, sys.stderr = sys.stderr, log
+    try:
+        bakes._report_missing_at_render(scene)
+    finally:
+        sys.stderr = saved
+    check("renders nothing" in log.getvalue() and "bake a volume" in log.getvalue(),
+          "the render log: %r" % log.getvalue().strip()[:120])
     with NoDeprecations("Bake Volume"):
         result = bpy.ops.dqjulia.bake_volume(synchronous=True)
     check(result == {"FINISHED"}, "Bake Volume finished")
@@ -650,6 +661,7 @@ def case_bake_volume():
     check(node is not None and node.inputs["Density Attribute"].default_value == "density",
           "a Principled Volume material reads the density grid")
     check(volume.matrix_world == obj.matrix_world, "the volume sits in the source's frame")
+    check(not bakes.unrendered_sources(scene), "with its bake it renders")
     result = bpy.ops.dqjulia.bake_volume(synchronous=True)
     again = baked_child(obj, "volume")
     check(result == {"FINISHED"} and again == volume and again.data.filepath != first_file
