@@ -20,7 +20,8 @@ CTYPES = {"int32_t": ctypes.c_int32, "double": ctypes.c_double, "uint64_t": ctyp
 
 def main():
     source = sys.argv[1]
-    header = open(source + "/core/include/dqjulia/dqjulia.h").read()
+    with open(source + "/core/include/dqjulia/dqjulia.h") as file:
+        header = file.read()
     header = re.sub(r"/\*.*?\*/", "", header, flags=re.S)
     spec = importlib.util.spec_from_file_location("native", source + "/blender_addon/dqjulia/native.py")
     native = importlib.util.module_from_spec(spec)
@@ -38,15 +39,16 @@ def main():
 
     functions = {}
     for name, arguments in re.findall(r"DQJ_API\s+[\w\s\*]+?\b(dqj_\w+)\s*\(([^)]*)\)", header):
-        arguments = arguments.strip()
-        functions[name] = 0 if arguments in ("", "void") else arguments.count(",") + 1
+        listed = arguments.strip()
+        functions[name] = 0 if listed in ("", "void") else listed.count(",") + 1
     for name, count in functions.items():
         bound = native._SIGNATURES.get(name)
         checks["function %s(%d arguments)" % (name, count)] = bound is not None and len(bound[1]) == count
     for name, (_restype, _argtypes, features) in native._SIGNATURES.items():
         checks["binding %s is in the header" % name] = name in functions
         checks["binding %s needs known features %s" % (name, features)] = features is None or (
-            len(features) > 0 and set(features) <= set(native.FEATURES))
+            len(features) > 0 and set(features) <= set(native.FEATURES)
+        )
 
     features = dict(re.findall(r"#define\s+DQJ_FEATURE_(\w+)\s+\"(\w+)\"", header))
     checks["features %s" % sorted(features.values())] = sorted(features.values()) == sorted(native.FEATURES)
@@ -60,8 +62,10 @@ def main():
         checks["struct %s fields" % struct] = fields == list(cls._fields_)
     # Growing structs start with struct_size (dqjulia.h); the frozen one (an array element) does not.
     checks["dqj_bake_stats starts with struct_size"] = native.BakeStats._fields_[0] == ("struct_size", ctypes.c_size_t)
-    checks["DQJ_BAKE_STATS_INIT sets struct_size"] = re.search(
-        r"#define\s+DQJ_BAKE_STATS_INIT\s+\{\.struct_size = sizeof\(dqj_bake_stats\)\}", header) is not None
+    checks["DQJ_BAKE_STATS_INIT sets struct_size"] = (
+        re.search(r"#define\s+DQJ_BAKE_STATS_INIT[\s\\]+\{\s*\.struct_size = sizeof\(dqj_bake_stats\)\s*\}", header)
+        is not None
+    )
 
     # dqj_progress_fn: non-zero goes on, 0 cancels.
     progress = native.Progress()
@@ -77,8 +81,8 @@ def main():
             name, *numbers = line.split()
             sizes[name] = [int(number) for number in numbers]
         for struct, cls in structs:
-            checks["sizeof(%s) = %s, ctypes %d" % (struct, sizes.get(struct), ctypes.sizeof(cls))] = (
-                sizes.get(struct) == [ctypes.sizeof(cls)])
+            size = sizes.get(struct)
+            checks["sizeof(%s) = %s, ctypes %d" % (struct, size, ctypes.sizeof(cls))] = size == [ctypes.sizeof(cls)]
             for field, kind in cls._fields_:
                 expected = [getattr(cls, field).offset, ctypes.sizeof(kind)]
                 found = sizes.get("%s.%s" % (struct, field))

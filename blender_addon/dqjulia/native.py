@@ -124,12 +124,29 @@ _SIGNATURES = {
     "dqj_context_set_iterations": (_status, [_handle, ctypes.c_int], None),
     "dqj_context_set_bailout": (_status, [_handle, ctypes.c_double], None),
     "dqj_context_set_slice_axes": (_status, [_handle, ctypes.c_char_p], None),
-    "dqj_evaluate_points": (_status, [_handle, ctypes.POINTER(ctypes.c_double), ctypes.c_size_t,
-                                      ctypes.POINTER(Sample)], None),
-    "dqj_evaluate_slice_points": (_status, [_handle, ctypes.POINTER(ctypes.c_double), ctypes.c_size_t,
-                                            ctypes.POINTER(Sample)], None),
-    "dqj_render_rgba8": (_status, [_handle, ctypes.POINTER(ctypes.c_uint8), ctypes.c_uint32, ctypes.c_uint32,
-                                   ctypes.c_size_t, PROGRESS_FN, ctypes.c_void_p], None),
+    "dqj_evaluate_points": (
+        _status,
+        [_handle, ctypes.POINTER(ctypes.c_double), ctypes.c_size_t, ctypes.POINTER(Sample)],
+        None,
+    ),
+    "dqj_evaluate_slice_points": (
+        _status,
+        [_handle, ctypes.POINTER(ctypes.c_double), ctypes.c_size_t, ctypes.POINTER(Sample)],
+        None,
+    ),
+    "dqj_render_rgba8": (
+        _status,
+        [
+            _handle,
+            ctypes.POINTER(ctypes.c_uint8),
+            ctypes.c_uint32,
+            ctypes.c_uint32,
+            ctypes.c_size_t,
+            PROGRESS_FN,
+            ctypes.c_void_p,
+        ],
+        None,
+    ),
     "dqj_render_to_file": (_status, [_handle, ctypes.c_char_p, PROGRESS_FN, ctypes.c_void_p], None),
     "dqj_inspect_json": (_status, [_handle, ctypes.c_void_p, ctypes.c_size_t, _size_p], None),
     # Optional: the add-on still previews and renders with a library without them.
@@ -139,9 +156,19 @@ _SIGNATURES = {
     "dqj_bake_vdb": (_status, [_handle, ctypes.c_char_p, PROGRESS_FN, ctypes.c_void_p], (FEATURE_VDB,)),
     "dqj_mesh_compute": (_status, [_handle, PROGRESS_FN, ctypes.c_void_p], (FEATURE_MESH,)),
     "dqj_mesh_get_sizes": (_status, [_handle, _size_p, _size_p], (FEATURE_MESH,)),
-    "dqj_mesh_copy": (_status, [_handle, ctypes.POINTER(ctypes.c_float), ctypes.POINTER(ctypes.c_float),
-                                ctypes.POINTER(ctypes.c_float), ctypes.c_size_t, ctypes.POINTER(ctypes.c_uint32),
-                                ctypes.c_size_t], (FEATURE_MESH,)),
+    "dqj_mesh_copy": (
+        _status,
+        [
+            _handle,
+            ctypes.POINTER(ctypes.c_float),
+            ctypes.POINTER(ctypes.c_float),
+            ctypes.POINTER(ctypes.c_float),
+            ctypes.c_size_t,
+            ctypes.POINTER(ctypes.c_uint32),
+            ctypes.c_size_t,
+        ],
+        (FEATURE_MESH,),
+    ),
     "dqj_mesh_write": (_status, [_handle, ctypes.c_char_p], (FEATURE_MESH,)),
     "dqj_bake_get_stats": (_status, [_handle, ctypes.POINTER(BakeStats)], _BAKE),
 }
@@ -178,7 +205,8 @@ def _bind(library):
         except AttributeError:
             raise NativeUnavailable(
                 "the dqjulia library at %s has no function %s: it is not the library this add-on was "
-                "built with; reinstall the add-on zip" % (_library_path, name)) from None
+                "built with; reinstall the add-on zip" % (_library_path, name)
+            ) from None
         function.restype = restype
         function.argtypes = argtypes
 
@@ -194,7 +222,7 @@ def _bind(library):
 
 
 def _load():
-    global _library, _load_error, _library_path
+    global _library_path
     path = library_path()
     _library_path = path
     if not os.path.isfile(path):
@@ -207,11 +235,11 @@ def _load():
         raise NativeUnavailable(
             "the dqjulia native library at %s could not be loaded (%s). It is self-contained and needs only "
             "Linux x86-64 with glibc 2.34 or newer (Debian 12, Ubuntu 22.04, RHEL 9 or later); on another "
-            "system, build the add-on there (README, Two commands)" % (path, error))
+            "system, build the add-on there (README, Two commands)" % (path, error)) from error
     try:
         version_number = library.dqj_version_number
     except AttributeError:
-        raise NativeUnavailable("%s is not the dqjulia library (no dqj_version_number)" % path)
+        raise NativeUnavailable("%s is not the dqjulia library (no dqj_version_number)" % path) from None
     version_number.restype = ctypes.c_uint
     version_number.argtypes = []
     found = version_number()
@@ -291,7 +319,8 @@ def _function(name):
     if name not in _bound:
         raise NativeUnavailable(
             "the dqjulia library %s has no %s (it lacks the feature %s); this add-on needs a library that has it"
-            % (version()[1], name, " or ".join(_SIGNATURES[name][2] or ()) if name in _SIGNATURES else "?"))
+            % (version()[1], name, " or ".join(_SIGNATURES[name][2] or ()) if name in _SIGNATURES else "?")
+        )
     return getattr(lib, name)
 
 

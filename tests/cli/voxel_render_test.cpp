@@ -77,8 +77,9 @@ std::pair<double, double> centroid(const std::vector<bool>& mask) {
     double x = 0.0, y = 0.0, count = 0.0;
     for (std::size_t index = 0; index < mask.size(); ++index)
         if (mask[index]) {
-            x += double(index % kWidth);
-            y += double(index / kWidth);
+            const std::size_t row = index / kWidth, column = index % kWidth;
+            x += double(column);
+            y += double(row);
             ++count;
         }
     return {x / count, y / count};
@@ -164,8 +165,8 @@ TEST_F(VoxelRender, TheUnitBallAsCubesLinesUpWithTheTracedBall) {
         if (traced.alpha[index] != 0.0f || voxels.alpha[index] != 0.0f) continue;
         ++background;
         for (int channel = 0; channel < 3; ++channel)
-            largestDifference = std::max(largestDifference,
-                                         std::abs(tracedPng.rgba[4 * index + channel] - voxelPng.rgba[4 * index + channel]));
+            largestDifference = std::max(largestDifference, std::abs(tracedPng.rgba[4 * index + channel] -
+                                                                     voxelPng.rgba[4 * index + channel]));
     }
     EXPECT_GT(background, voxelMask.size() / 4);
     EXPECT_LE(largestDifference, 1.0f / 255) << "the background differs from render()'s";

@@ -71,10 +71,12 @@ DQJ_API const char* dqj_status_string(dqj_status status);
  * a name it does not know, such as one added by a later version). The functions of a feature
  * the library lacks may be missing from it or refuse to work; ask before using them. */
 DQJ_API int dqj_has_feature(const char* name);
-#define DQJ_FEATURE_VDB "vdb"             /* dqj_bake_vdb, with dqj_context_set_bake_resolution,
-                                             dqj_context_set_memory_limit and dqj_bake_get_stats */
-#define DQJ_FEATURE_MESH "mesh"           /* dqj_mesh_*, with the same three */
-#define DQJ_FEATURE_ANIMATION "animation" /* keyframes (the parameters' "animation"), dqj_context_set_frame */
+/* dqj_bake_vdb, with dqj_context_set_bake_resolution, dqj_context_set_memory_limit, dqj_bake_get_stats */
+#define DQJ_FEATURE_VDB "vdb"
+/* dqj_mesh_*, with the same three */
+#define DQJ_FEATURE_MESH "mesh"
+/* keyframes (the parameters' "animation") and dqj_context_set_frame */
+#define DQJ_FEATURE_ANIMATION "animation"
 
 typedef enum dqj_variant {
     DQJ_VARIANT_PAPER = 0,         /* the paper's rule: a and b iterate independently */
@@ -207,7 +209,9 @@ typedef struct dqj_bake_stats {
     uint64_t estimated_bytes;  /* the memory estimate checked against the limit */
     double seconds;            /* wall-clock time */
 } dqj_bake_stats;
-#define DQJ_BAKE_STATS_INIT {.struct_size = sizeof(dqj_bake_stats)} /* C99, C++20 */
+/* An initialiser that sets struct_size (designated: C99, C++20). */
+#define DQJ_BAKE_STATS_INIT \
+    { .struct_size = sizeof(dqj_bake_stats) }
 DQJ_API dqj_status dqj_bake_get_stats(dqj_context context, dqj_bake_stats* out_stats);
 
 #ifdef __cplusplus
