@@ -33,12 +33,14 @@ build="${DQJ_BUILD_DIR:-build}"
 jobs="$(nproc)"
 
 failed=0
+skipped=""
 missing() {  # the project's rule for a missing tool (tests/script_support.cmake)
   if [ "${CI:-}" = "true" ]; then
     echo "check-style: $1 (CI=true: every check must run)" >&2
     failed=1
   else
     echo "DQJ_TEST_SKIPPED: $1"
+    skipped=" (but not every check ran)"
   fi
 }
 have() { command -v "$1" >/dev/null 2>&1; }
@@ -179,4 +181,4 @@ if [ "$failed" -ne 0 ]; then
   echo "check-style: FAILED (scripts/check-style.sh --fix reformats the changed lines; README, Style)" >&2
   exit 1
 fi
-echo "check-style: clean"
+echo "check-style: clean$skipped"
