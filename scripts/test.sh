@@ -6,6 +6,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 scripts/bpy-env.sh
+scripts/ruff-env.sh
 scripts/build.sh
 ctest --test-dir build --output-on-failure -j"$(nproc)"
 

@@ -1,13 +1,17 @@
 """The add-on's ctypes bindings (blender_addon/dqjulia/native.py) against the C header
-(core/include/dqjulia/dqjulia.h): every status code, every function with its argument count,
-and the fields of every struct, so the bindings can never drift from the ABI they describe.
+(core/include/dqjulia/dqjulia.h): every status code, feature name and function with its
+argument count, the fields of every struct, and the progress callback's convention, so the
+bindings can never drift from the ABI they describe. Given the C test program, also each
+struct's size and each field's offset and size as the C compiler lays them out
+(`c_api_test --layout`) against ctypes'.
 
-Usage: python3 native_abi_test.py SOURCE_DIR
+Usage: python3 native_abi_test.py SOURCE_DIR [C_API_TEST]
 """
 
 import ctypes
 import importlib.util
 import re
+import subprocess
 import sys
 
 CTYPES = {"int32_t": ctypes.c_int32, "double": ctypes.c_double, "uint64_t": ctypes.c_uint64,
@@ -16,7 +20,8 @@ CTYPES = {"int32_t": ctypes.c_int32, "double": ctypes.c_double, "uint64_t": ctyp
 
 def main():
     source = sys.argv[1]
-    header = open(source + "/core/include/dqjulia/dqjulia.h").read()
+    with open(source + "/core/include/dqjulia/dqjulia.h") as file:
+        header = file.read()
     header = re.sub(r"/\*.*?\*/", "", header, flags=re.S)
     spec = importlib.util.spec_from_file_location("native", source + "/blender_addon/dqjulia/native.py")
     native = importlib.util.module_from_spec(spec)
@@ -34,18 +39,54 @@ def main():
 
     functions = {}
     for name, arguments in re.findall(r"DQJ_API\s+[\w\s\*]+?\b(dqj_\w+)\s*\(([^)]*)\)", header):
-        arguments = arguments.strip()
-        functions[name] = 0 if arguments in ("", "void") else arguments.count(",") + 1
+        listed = arguments.strip()
+        functions[name] = 0 if listed in ("", "void") else listed.count(",") + 1
     for name, count in functions.items():
         bound = native._SIGNATURES.get(name)
         checks["function %s(%d arguments)" % (name, count)] = bound is not None and len(bound[1]) == count
-    for name in native._SIGNATURES:
+    for name, (_restype, _argtypes, features) in native._SIGNATURES.items():
         checks["binding %s is in the header" % name] = name in functions
+        checks["binding %s needs known features %s" % (name, features)] = features is None or (
+            len(features) > 0 and set(features) <= set(native.FEATURES)
+        )
 
-    for struct, cls in (("dqj_sample", native.Sample), ("dqj_bake_stats", native.BakeStats)):
+    features = dict(re.findall(r"#define\s+DQJ_FEATURE_(\w+)\s+\"(\w+)\"", header))
+    checks["features %s" % sorted(features.values())] = sorted(features.values()) == sorted(native.FEATURES)
+    for name, value in features.items():
+        checks["feature %s = %r" % (name, value)] = getattr(native, "FEATURE_" + name, None) == value
+
+    structs = (("dqj_sample", native.Sample), ("dqj_bake_stats", native.BakeStats))
+    for struct, cls in structs:
         body = re.search(r"typedef struct %s \{(.*?)\} %s;" % (struct, struct), header, re.S).group(1)
         fields = [(name, CTYPES[kind]) for kind, name in re.findall(r"(\w+)\s+(\w+);", body)]
         checks["struct %s fields" % struct] = fields == list(cls._fields_)
+    # Growing structs start with struct_size (dqjulia.h); the frozen one (an array element) does not.
+    checks["dqj_bake_stats starts with struct_size"] = native.BakeStats._fields_[0] == ("struct_size", ctypes.c_size_t)
+    checks["DQJ_BAKE_STATS_INIT sets struct_size"] = (
+        re.search(r"#define\s+DQJ_BAKE_STATS_INIT[\s\\]+\{\s*\.struct_size = sizeof\(dqj_bake_stats\)\s*\}", header)
+        is not None
+    )
+
+    # dqj_progress_fn: non-zero goes on, 0 cancels.
+    progress = native.Progress()
+    checks["progress goes on with non-zero"] = progress._report(0.5, None) != 0
+    progress.cancel()
+    checks["progress cancels with 0"] = progress._report(0.6, None) == 0
+
+    if len(sys.argv) > 2:
+        # Lines "STRUCT SIZE" and "STRUCT.FIELD OFFSET SIZE".
+        layout = subprocess.run([sys.argv[2], "--layout"], check=True, capture_output=True, text=True).stdout
+        sizes = {}
+        for line in layout.splitlines():
+            name, *numbers = line.split()
+            sizes[name] = [int(number) for number in numbers]
+        for struct, cls in structs:
+            size = sizes.get(struct)
+            checks["sizeof(%s) = %s, ctypes %d" % (struct, size, ctypes.sizeof(cls))] = size == [ctypes.sizeof(cls)]
+            for field, kind in cls._fields_:
+                expected = [getattr(cls, field).offset, ctypes.sizeof(kind)]
+                found = sizes.get("%s.%s" % (struct, field))
+                checks["%s.%s at %s in C, %s in ctypes" % (struct, field, found, expected)] = found == expected
 
     for name, ok in checks.items():
         if not ok:

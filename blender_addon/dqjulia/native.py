@@ -5,8 +5,10 @@ add-on registers (and its panels can explain the problem) even when the library 
 or of the wrong version; `load_error()` gives that explanation in words a user can act on.
 
 Every function is declared with its argtypes and restype. Functions the add-on can live
-without (baking, added to the ABI later) are optional: `has(name)` says whether the loaded
-library has them, and calling a missing one raises NativeUnavailable with the reason.
+without (baking, keyframes) belong to optional features, which the library is asked for
+(dqj_has_feature), never probed for symbols: `has_feature(name)` and `has(function)` say
+whether the loaded library has them, and calling a missing one raises NativeUnavailable with
+the reason.
 
 No bpy here: the module is used from worker threads (ctypes releases the GIL during each
 call) and by the tests outside Blender.
@@ -43,6 +45,12 @@ ERROR_BUSY = 8  # a call on the context is running (e.g. destroy from its own pr
 
 VARIANTS = ("paper", "paper-coupled", "dual")  # dqj_variant order
 
+# The optional features this add-on knows (DQJ_FEATURE_*), for dqj_has_feature.
+FEATURE_VDB = "vdb"
+FEATURE_MESH = "mesh"
+FEATURE_ANIMATION = "animation"
+FEATURES = (FEATURE_VDB, FEATURE_MESH, FEATURE_ANIMATION)
+
 
 class NativeUnavailable(RuntimeError):
     """The library could not be loaded (missing, wrong version, or lacks a function)."""
@@ -74,9 +82,11 @@ class Sample(ctypes.Structure):
 
 
 class BakeStats(ctypes.Structure):
-    """dqj_bake_stats: what the last bake or mesh cost."""
+    """dqj_bake_stats: what the last bake or mesh cost. A growing struct: struct_size is set to
+    this class's size before each call (Context.bake_stats does)."""
 
     _fields_ = [
+        ("struct_size", ctypes.c_size_t),
         ("voxels_evaluated", ctypes.c_uint64),
         ("voxels_dense", ctypes.c_uint64),
         ("active_voxels", ctypes.c_uint64),
@@ -85,7 +95,7 @@ class BakeStats(ctypes.Structure):
     ]
 
 
-# typedef int (*dqj_progress_fn)(double fraction, void* user_data);
+# typedef int (*dqj_progress_fn)(double fraction, void* user_data); non-zero goes on, 0 cancels.
 PROGRESS_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, ctypes.c_void_p)
 
 _handle = ctypes.c_void_p
@@ -93,50 +103,83 @@ _status = ctypes.c_int
 _size_p = ctypes.POINTER(ctypes.c_size_t)
 _char_buffer = ctypes.c_char_p
 
-# name: (restype, argtypes, required)
+_BAKE = (FEATURE_VDB, FEATURE_MESH)  # the calls bakes and meshes share
+
+# name: (restype, argtypes, features): None for a function every library has, else the
+# features of which any one brings it.
 _SIGNATURES = {
-    "dqj_version_number": (ctypes.c_uint, [], True),
-    "dqj_version_string": (ctypes.c_char_p, [], True),
-    "dqj_status_string": (ctypes.c_char_p, [ctypes.c_int], True),
-    "dqj_context_create": (_status, [ctypes.POINTER(_handle)], True),
-    "dqj_context_destroy": (_status, [_handle], True),
-    "dqj_context_error": (ctypes.c_char_p, [_handle], True),
-    "dqj_context_warning": (ctypes.c_char_p, [_handle], True),
-    "dqj_context_load_params_file": (_status, [_handle, ctypes.c_char_p], True),
-    "dqj_context_set_params_json": (_status, [_handle, ctypes.c_char_p], True),
-    "dqj_context_get_params_json": (_status, [_handle, ctypes.c_void_p, ctypes.c_size_t, _size_p], True),
-    "dqj_params_schema_json": (_status, [_handle, ctypes.c_void_p, ctypes.c_size_t, _size_p], True),
-    "dqj_context_set_constant": (_status, [_handle, ctypes.POINTER(ctypes.c_double)], True),
-    "dqj_context_set_variant": (_status, [_handle, ctypes.c_int], True),
-    "dqj_context_set_iterations": (_status, [_handle, ctypes.c_int], True),
-    "dqj_context_set_bailout": (_status, [_handle, ctypes.c_double], True),
-    "dqj_context_set_slice_axes": (_status, [_handle, ctypes.c_char_p], True),
-    "dqj_evaluate_points": (_status, [_handle, ctypes.POINTER(ctypes.c_double), ctypes.c_size_t,
-                                      ctypes.POINTER(Sample)], True),
-    "dqj_evaluate_slice_points": (_status, [_handle, ctypes.POINTER(ctypes.c_double), ctypes.c_size_t,
-                                            ctypes.POINTER(Sample)], True),
-    "dqj_render_rgba8": (_status, [_handle, ctypes.POINTER(ctypes.c_uint8), ctypes.c_uint32, ctypes.c_uint32,
-                                   ctypes.c_size_t, PROGRESS_FN, ctypes.c_void_p], True),
-    "dqj_render_to_file": (_status, [_handle, ctypes.c_char_p, PROGRESS_FN, ctypes.c_void_p], True),
-    "dqj_inspect_json": (_status, [_handle, ctypes.c_void_p, ctypes.c_size_t, _size_p], True),
-    # Baking (optional: the add-on still previews and renders with a library without them).
-    "dqj_context_set_bake_resolution": (_status, [_handle, ctypes.c_int], False),
-    "dqj_context_set_frame": (_status, [_handle, ctypes.c_double], False),
-    "dqj_context_set_memory_limit": (_status, [_handle, ctypes.c_uint64], False),
-    "dqj_bake_vdb": (_status, [_handle, ctypes.c_char_p, PROGRESS_FN, ctypes.c_void_p], False),
-    "dqj_mesh_compute": (_status, [_handle, PROGRESS_FN, ctypes.c_void_p], False),
-    "dqj_mesh_get_sizes": (_status, [_handle, _size_p, _size_p], False),
-    "dqj_mesh_copy": (_status, [_handle, ctypes.POINTER(ctypes.c_float), ctypes.POINTER(ctypes.c_float),
-                                ctypes.POINTER(ctypes.c_float), ctypes.c_size_t, ctypes.POINTER(ctypes.c_uint32),
-                                ctypes.c_size_t], False),
-    "dqj_mesh_write": (_status, [_handle, ctypes.c_char_p], False),
-    "dqj_bake_get_stats": (_status, [_handle, ctypes.POINTER(BakeStats)], False),
+    "dqj_version_number": (ctypes.c_uint, [], None),
+    "dqj_version_string": (ctypes.c_char_p, [], None),
+    "dqj_status_string": (ctypes.c_char_p, [ctypes.c_int], None),
+    "dqj_has_feature": (ctypes.c_int, [ctypes.c_char_p], None),
+    "dqj_context_create": (_status, [ctypes.POINTER(_handle)], None),
+    "dqj_context_destroy": (_status, [_handle], None),
+    "dqj_context_error": (ctypes.c_char_p, [_handle], None),
+    "dqj_context_warning": (ctypes.c_char_p, [_handle], None),
+    "dqj_context_load_params_file": (_status, [_handle, ctypes.c_char_p], None),
+    "dqj_context_set_params_json": (_status, [_handle, ctypes.c_char_p], None),
+    "dqj_context_get_params_json": (_status, [_handle, ctypes.c_void_p, ctypes.c_size_t, _size_p], None),
+    "dqj_params_schema_json": (_status, [_handle, ctypes.c_void_p, ctypes.c_size_t, _size_p], None),
+    "dqj_context_set_constant": (_status, [_handle, ctypes.POINTER(ctypes.c_double)], None),
+    "dqj_context_set_variant": (_status, [_handle, ctypes.c_int], None),
+    "dqj_context_set_iterations": (_status, [_handle, ctypes.c_int], None),
+    "dqj_context_set_bailout": (_status, [_handle, ctypes.c_double], None),
+    "dqj_context_set_slice_axes": (_status, [_handle, ctypes.c_char_p], None),
+    "dqj_evaluate_points": (
+        _status,
+        [_handle, ctypes.POINTER(ctypes.c_double), ctypes.c_size_t, ctypes.POINTER(Sample)],
+        None,
+    ),
+    "dqj_evaluate_slice_points": (
+        _status,
+        [_handle, ctypes.POINTER(ctypes.c_double), ctypes.c_size_t, ctypes.POINTER(Sample)],
+        None,
+    ),
+    "dqj_render_rgba8": (
+        _status,
+        [
+            _handle,
+            ctypes.POINTER(ctypes.c_uint8),
+            ctypes.c_uint32,
+            ctypes.c_uint32,
+            ctypes.c_size_t,
+            PROGRESS_FN,
+            ctypes.c_void_p,
+        ],
+        None,
+    ),
+    "dqj_render_to_file": (_status, [_handle, ctypes.c_char_p, PROGRESS_FN, ctypes.c_void_p], None),
+    "dqj_inspect_json": (_status, [_handle, ctypes.c_void_p, ctypes.c_size_t, _size_p], None),
+    # Optional: the add-on still previews and renders with a library without them.
+    "dqj_context_set_bake_resolution": (_status, [_handle, ctypes.c_int], _BAKE),
+    "dqj_context_set_frame": (_status, [_handle, ctypes.c_double], (FEATURE_ANIMATION,)),
+    "dqj_context_set_memory_limit": (_status, [_handle, ctypes.c_uint64], _BAKE),
+    "dqj_bake_vdb": (_status, [_handle, ctypes.c_char_p, PROGRESS_FN, ctypes.c_void_p], (FEATURE_VDB,)),
+    "dqj_mesh_compute": (_status, [_handle, PROGRESS_FN, ctypes.c_void_p], (FEATURE_MESH,)),
+    "dqj_mesh_get_sizes": (_status, [_handle, _size_p, _size_p], (FEATURE_MESH,)),
+    "dqj_mesh_copy": (
+        _status,
+        [
+            _handle,
+            ctypes.POINTER(ctypes.c_float),
+            ctypes.POINTER(ctypes.c_float),
+            ctypes.POINTER(ctypes.c_float),
+            ctypes.c_size_t,
+            ctypes.POINTER(ctypes.c_uint32),
+            ctypes.c_size_t,
+        ],
+        (FEATURE_MESH,),
+    ),
+    "dqj_mesh_write": (_status, [_handle, ctypes.c_char_p], (FEATURE_MESH,)),
+    "dqj_bake_get_stats": (_status, [_handle, ctypes.POINTER(BakeStats)], _BAKE),
 }
 
 _lock = threading.Lock()
 _library = None
 _load_error = None
 _library_path = None
+_features = frozenset()  # the FEATURES the loaded library has
+_bound = frozenset()  # the functions of _SIGNATURES it offers
 
 
 def version_text(number):
@@ -154,21 +197,33 @@ def library_path():
 
 
 def _bind(library):
-    for name, (restype, argtypes, required) in _SIGNATURES.items():
+    """Declares the functions the library offers: every required one, and those of the
+    optional features it says it has. Returns (features, function names)."""
+
+    def declare(name, restype, argtypes):
         try:
             function = getattr(library, name)
         except AttributeError:
-            if required:
-                raise NativeUnavailable(
-                    "the dqjulia library at %s has no function %s: it is not the library this add-on was "
-                    "built with; reinstall the add-on zip" % (_library_path, name))
-            continue
+            raise NativeUnavailable(
+                "the dqjulia library at %s has no function %s: it is not the library this add-on was "
+                "built with; reinstall the add-on zip" % (_library_path, name)
+            ) from None
         function.restype = restype
         function.argtypes = argtypes
 
+    restype, argtypes, _ = _SIGNATURES["dqj_has_feature"]
+    declare("dqj_has_feature", restype, argtypes)
+    features = frozenset(name for name in FEATURES if library.dqj_has_feature(name.encode()) == 1)
+    bound = set()
+    for name, (restype, argtypes, needs) in _SIGNATURES.items():
+        if needs is None or features.intersection(needs):
+            declare(name, restype, argtypes)
+            bound.add(name)
+    return features, frozenset(bound)
+
 
 def _load():
-    global _library, _load_error, _library_path
+    global _library_path
     path = library_path()
     _library_path = path
     if not os.path.isfile(path):
@@ -181,11 +236,11 @@ def _load():
         raise NativeUnavailable(
             "the dqjulia native library at %s could not be loaded (%s). It is self-contained and needs only "
             "Linux x86-64 with glibc 2.34 or newer (Debian 12, Ubuntu 22.04, RHEL 9 or later); on another "
-            "system, build the add-on there (README, Two commands)" % (path, error))
+            "system, build the add-on there (README, Two commands)" % (path, error)) from error
     try:
         version_number = library.dqj_version_number
     except AttributeError:
-        raise NativeUnavailable("%s is not the dqjulia library (no dqj_version_number)" % path)
+        raise NativeUnavailable("%s is not the dqjulia library (no dqj_version_number)" % path) from None
     version_number.restype = ctypes.c_uint
     version_number.argtypes = []
     found = version_number()
@@ -194,17 +249,16 @@ def _load():
             "the dqjulia library at %s is version %s, but this add-on needs %s (same major version, not "
             "older): install the add-on zip and the library from the same build"
             % (path, version_text(found), version_text(EXPECTED_VERSION)))
-    _bind(library)
-    return library
+    return library, _bind(library)
 
 
 def library():
     """The loaded library; raises NativeUnavailable (with the reason) if it cannot be used."""
-    global _library, _load_error
+    global _library, _load_error, _features, _bound
     with _lock:
         if _library is None and _load_error is None:
             try:
-                _library = _load()
+                _library, (_features, _bound) = _load()
             except NativeUnavailable as error:
                 _load_error = str(error)
         if _library is None:
@@ -223,18 +277,32 @@ def load_error():
 
 def reset():
     """Forget the loaded library and the last error, so the next use tries again (tests)."""
-    global _library, _load_error
+    global _library, _load_error, _features, _bound
     with _lock:
         _library = None
         _load_error = None
+        _features = frozenset()
+        _bound = frozenset()
+
+
+def has_feature(name):
+    """Whether the loaded library has this optional feature (FEATURE_*; False if it cannot be
+    loaded or the add-on does not know the name)."""
+    try:
+        library()
+    except NativeUnavailable:
+        return False
+    return name in _features
 
 
 def has(name):
-    """Whether the loaded library has this function (False if it cannot be loaded)."""
+    """Whether the loaded library offers this function of _SIGNATURES (False if it cannot be
+    loaded)."""
     try:
-        return name in _SIGNATURES and hasattr(library(), name)
+        library()
     except NativeUnavailable:
         return False
+    return name in _bound
 
 
 def version():
@@ -249,9 +317,11 @@ def status_text(status):
 
 def _function(name):
     lib = library()
-    if name not in _SIGNATURES or not hasattr(lib, name):
+    if name not in _bound:
         raise NativeUnavailable(
-            "the dqjulia library %s has no %s; this add-on needs a newer library" % (version()[1], name))
+            "the dqjulia library %s has no %s (it lacks the feature %s); this add-on needs a library that has it"
+            % (version()[1], name, " or ".join(_SIGNATURES[name][2] or ()) if name in _SIGNATURES else "?")
+        )
     return getattr(lib, name)
 
 
@@ -276,7 +346,7 @@ class Progress:
                 self._on_progress(self.fraction)
         except Exception:  # an exception must never unwind into C
             pass
-        return 1 if self._cancel.is_set() else 0
+        return 0 if self._cancel.is_set() else 1  # dqj_progress_fn: non-zero goes on, 0 cancels
 
     def cancel(self):
         self._cancel.set()
@@ -461,6 +531,6 @@ class Context:
         self.check(_function("dqj_mesh_write")(self.handle, os.fsencode(path)), "mesh write")
 
     def bake_stats(self):
-        stats = BakeStats()
+        stats = BakeStats(struct_size=ctypes.sizeof(BakeStats))
         self.check(_function("dqj_bake_get_stats")(self.handle, ctypes.byref(stats)), "bake stats")
         return stats

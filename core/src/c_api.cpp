@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstring>
 #include <mutex>
 #include <new>
@@ -154,7 +155,7 @@ dqj_status copyText(dqj_context_t& context, const std::string& text, char* buffe
 
 dqj::ProgressCallback wrapProgress(dqj_progress_fn progress, void* userData) {
     if (!progress) return {};
-    return [progress, userData](double fraction) { return progress(fraction, userData) == 0; };
+    return [progress, userData](double fraction) { return progress(fraction, userData) != 0; };  // 0 cancels
 }
 
 void fillSample(const dqj::Escape& escape, dqj_sample& sample) {
@@ -230,6 +231,14 @@ const char* dqj_status_string(dqj_status status) {
         case DQJ_ERROR_BUSY: return "context busy (a call on it is running)";
     }
     return "unknown status";
+}
+
+int dqj_has_feature(const char* name) {
+    if (!name) return 0;
+    // Every build has them today; the names are for builds and hosts that may not.
+    for (const char* feature : {DQJ_FEATURE_VDB, DQJ_FEATURE_MESH, DQJ_FEATURE_ANIMATION})
+        if (std::strcmp(name, feature) == 0) return 1;
+    return 0;
 }
 
 dqj_status dqj_context_create(dqj_context* outContext) {
@@ -529,11 +538,20 @@ dqj_status dqj_mesh_write(dqj_context context, const char* path) {
 dqj_status dqj_bake_get_stats(dqj_context context, dqj_bake_stats* outStats) {
     return guarded(context, [&](dqj_context_t& self) {
         if (!outStats) return invalidArgument(self, "out_stats is NULL");
-        outStats->voxels_evaluated = self.bakeStats.evaluated;
-        outStats->voxels_dense = self.bakeStats.dense;
-        outStats->active_voxels = self.bakeStats.activeVoxels;
-        outStats->estimated_bytes = self.bakeStats.estimatedBytes;
-        outStats->seconds = self.bakeStats.seconds;
+        // The first version of the struct ends with `seconds`; later fields are appended after it.
+        constexpr size_t firstVersionSize = offsetof(dqj_bake_stats, seconds) + sizeof(double);
+        const size_t given = outStats->struct_size;
+        if (given < firstVersionSize)
+            return invalidArgument(self, "out_stats->struct_size is " + std::to_string(given) +
+                                             ": set it to sizeof(dqj_bake_stats) (DQJ_BAKE_STATS_INIT)");
+        dqj_bake_stats stats{};
+        stats.voxels_evaluated = self.bakeStats.evaluated;
+        stats.voxels_dense = self.bakeStats.dense;
+        stats.active_voxels = self.bakeStats.activeVoxels;
+        stats.estimated_bytes = self.bakeStats.estimatedBytes;
+        stats.seconds = self.bakeStats.seconds;
+        stats.struct_size = std::min(given, sizeof stats);  // an older library fills less than a newer caller's size
+        std::memcpy(outStats, &stats, stats.struct_size);
         return DQJ_OK;
     });
 }

@@ -263,6 +263,9 @@ def case_library():
           % (text, native.version_text(native.EXPECTED_VERSION)))
     check(native.library_path().startswith(ADDON_DIR) and os.path.isfile(native.library_path())
           and not os.path.islink(native.library_path()), "the library is a real file inside the installed add-on")
+    for feature in native.FEATURES:
+        check(native.has_feature(feature), "the library has the feature %s" % feature)
+    check(not native.has_feature("no-such-feature"), "an unknown feature is reported missing")
     for name in ("dqj_bake_vdb", "dqj_mesh_compute", "dqj_mesh_get_sizes", "dqj_mesh_copy"):
         check(native.has(name), "the library has %s" % name)
 

@@ -1,6 +1,12 @@
-/* The C ABI used from a program written in C (not C++): versions, parameters, evaluation
- * against reference values, errors per handle, rendering with progress and cancel. */
+/* The C ABI used from a program written in C (not C++): versions, features, parameters,
+ * evaluation against reference values, errors per handle, rendering with progress and cancel,
+ * a growing result struct.
+ *
+ *   c_api_test [SCRATCH_DIR]   the checks
+ *   c_api_test --layout        prints the size of each struct and the offset and size of each
+ *                              field, for tests/native_abi_test.py to hold the ctypes bindings to */
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -34,13 +40,13 @@ static int count_calls(double fraction, void* user_data) {
     int* calls = (int*)user_data;
     (void)fraction;
     ++*calls;
-    return 0;
+    return 1; /* go on */
 }
 
 static int cancel_at_once(double fraction, void* user_data) {
     (void)fraction;
     (void)user_data;
-    return 1;
+    return 0; /* cancel */
 }
 
 static void test_versions(void) {
@@ -48,6 +54,65 @@ static void test_versions(void) {
           DQJ_VERSION_NUMBER);
     CHECK(strlen(dqj_version_string()) >= 5, "version string too short");
     CHECK(strcmp(dqj_status_string(DQJ_ERROR_INVALID_HANDLE), "invalid handle") == 0, "status text");
+}
+
+static void test_features(void) {
+    CHECK(dqj_has_feature(DQJ_FEATURE_VDB) == 1, "no feature vdb");
+    CHECK(dqj_has_feature(DQJ_FEATURE_MESH) == 1, "no feature mesh");
+    CHECK(dqj_has_feature(DQJ_FEATURE_ANIMATION) == 1, "no feature animation");
+    CHECK(dqj_has_feature("teleportation") == 0, "an unknown feature is reported");
+    CHECK(dqj_has_feature(NULL) == 0, "NULL is a feature");
+}
+
+static void test_bake_stats(dqj_context context) {
+    /* The struct as a newer header might have it: the fields of this one, then more. */
+    struct newer {
+        dqj_bake_stats known;
+        uint64_t added;
+    } newer;
+    dqj_bake_stats stats = DQJ_BAKE_STATS_INIT;
+    dqj_bake_stats unset;
+    int calls = 0;
+    CHECK(dqj_context_set_params_json(context, "{\"bake\": {\"resolution\": 16}}") == DQJ_OK, "params: %s",
+          dqj_context_error(context));
+    CHECK(dqj_mesh_compute(context, count_calls, &calls) == DQJ_OK && calls >= 2, "mesh: %s",
+          dqj_context_error(context));
+    CHECK(dqj_bake_get_stats(context, &stats) == DQJ_OK, "stats: %s", dqj_context_error(context));
+    CHECK(stats.struct_size == sizeof stats, "struct_size became %zu", stats.struct_size);
+    CHECK(stats.voxels_dense == 16 * 16 * 16 && stats.voxels_evaluated > 0, "stats: dense %llu, evaluated %llu",
+          (unsigned long long)stats.voxels_dense, (unsigned long long)stats.voxels_evaluated);
+
+    /* A caller with a larger struct gets what this library knows, and is told how much that is. */
+    memset(&newer, 0xab, sizeof newer);
+    newer.known.struct_size = sizeof newer;
+    CHECK(dqj_bake_get_stats(context, &newer.known) == DQJ_OK, "stats into a larger struct");
+    CHECK(newer.known.struct_size == sizeof(dqj_bake_stats), "filled %zu bytes", newer.known.struct_size);
+    CHECK(newer.known.voxels_dense == stats.voxels_dense, "known field not filled");
+    CHECK(newer.added == 0xababababababababull, "a field the library does not know was written");
+
+    /* One that forgot struct_size is refused. */
+    memset(&unset, 0, sizeof unset);
+    CHECK(dqj_bake_get_stats(context, &unset) == DQJ_ERROR_INVALID_ARGUMENT, "struct_size 0 accepted");
+    CHECK(strstr(dqj_context_error(context), "struct_size") != NULL, "message: %s", dqj_context_error(context));
+}
+
+#define FIELD(type, field) printf("%s.%s %zu %zu\n", #type, #field, offsetof(type, field), sizeof(((type*)0)->field))
+
+static int print_layout(void) {
+    printf("dqj_sample %zu\n", sizeof(dqj_sample));
+    FIELD(dqj_sample, n);
+    FIELD(dqj_sample, r);
+    FIELD(dqj_sample, ra);
+    FIELD(dqj_sample, rb);
+    FIELD(dqj_sample, de);
+    printf("dqj_bake_stats %zu\n", sizeof(dqj_bake_stats));
+    FIELD(dqj_bake_stats, struct_size);
+    FIELD(dqj_bake_stats, voxels_evaluated);
+    FIELD(dqj_bake_stats, voxels_dense);
+    FIELD(dqj_bake_stats, active_voxels);
+    FIELD(dqj_bake_stats, estimated_bytes);
+    FIELD(dqj_bake_stats, seconds);
+    return 0;
 }
 
 static void test_reference_values(dqj_context context) {
@@ -172,12 +237,15 @@ static void test_empty_slice(dqj_context context) {
 int main(int argc, char** argv) {
     dqj_context context = NULL;
     const char* scratch = argc > 1 ? argv[1] : ".";
+    if (argc > 1 && strcmp(argv[1], "--layout") == 0) return print_layout();
     test_versions();
+    test_features();
     CHECK(dqj_context_create(&context) == DQJ_OK, "create");
     test_reference_values(context);
     test_errors(context);
     test_render(context, scratch);
     test_empty_slice(context);
+    test_bake_stats(context);
     dqj_context_destroy(context);
     printf("%d passed, %d failed\n", checks - failures, failures);
     return failures == 0 ? 0 : 1;

@@ -434,7 +434,7 @@ TEST_F(BakeCApi, MeshIntoCallerBuffers) {
               DQJ_ERROR_INVALID_ARGUMENT);
     EXPECT_NE(std::string(dqj_context_error(context_)).find("too small"), std::string::npos);
     ASSERT_EQ(dqj_mesh_copy(context_, positions.data(), normals.data(), colors.data(), vertices, indices.data(), triangles), DQJ_OK);
-    dqj_bake_stats stats{};
+    dqj_bake_stats stats = DQJ_BAKE_STATS_INIT;
     ASSERT_EQ(dqj_bake_get_stats(context_, &stats), DQJ_OK);
     for (size_t index = 0; index < vertices; ++index) {
         const glm::vec3 p(positions[3 * index], positions[3 * index + 1], positions[3 * index + 2]);
@@ -460,7 +460,7 @@ TEST_F(BakeCApi, MeshIntoCallerBuffers) {
 
 int cancelAfterStart(double fraction, void* calls) {
     ++*static_cast<int*>(calls);
-    return fraction > 0.0;  // non-zero: cancel once the work is under way
+    return fraction == 0.0;  // 0: cancel once the work is under way
 }
 
 TEST_F(BakeCApi, BakeWithCancelMemoryLimitAndFrames) {
@@ -485,7 +485,7 @@ TEST_F(BakeCApi, BakeWithCancelMemoryLimitAndFrames) {
     // Keyframed iterations: frame 1 and frame 3 bake different surfaces.
     ASSERT_EQ(dqj_context_set_params_json(context_, R"({"bake": {"resolution": 32},
         "animation": {"fractal.iterations": [{"frame": 1, "value": 4}, {"frame": 3, "value": 15}]}})"), DQJ_OK);
-    dqj_bake_stats first{}, third{};
+    dqj_bake_stats first = DQJ_BAKE_STATS_INIT, third = DQJ_BAKE_STATS_INIT;
     ASSERT_EQ(dqj_context_set_frame(context_, 1), DQJ_OK);
     ASSERT_EQ(dqj_bake_vdb(context_, path("f1.vdb").c_str(), nullptr, nullptr), DQJ_OK);
     ASSERT_EQ(dqj_bake_get_stats(context_, &first), DQJ_OK);

@@ -86,7 +86,7 @@ TEST_F(Hostile, BakeOntoAFullDiskFailsAndKeepsTheOldFile) {
     }
 }
 
-int keepGoing(double, void*) { return 0; }
+int keepGoing(double, void*) { return 1; }  // non-zero: go on
 
 TEST_F(Hostile, CBakeOntoAFullDiskReturnsAnIoError) {
     if (!mountTmpfs("disk", "96k")) GTEST_SKIP() << "cannot mount a tmpfs here: " << std::strerror(errno);
@@ -373,7 +373,7 @@ int destroyFromCallback(double, void* data) {
         attempt->tried = true;
         attempt->status = dqj_context_destroy(attempt->context);
     }
-    return 0;
+    return 1;  // go on
 }
 
 TEST(HostileC, DestroyingAContextFromItsOwnCallbackIsRefused) {
@@ -404,7 +404,7 @@ int nestedCall(double, void* data) {
         attempt->tried = true;
         attempt->status = dqj_context_set_iterations(attempt->context, 9);
     }
-    return 0;
+    return 1;  // go on
 }
 
 TEST(HostileC, ACallOnABusyContextIsRefused) {
@@ -414,6 +414,29 @@ TEST(HostileC, ACallOnABusyContextIsRefused) {
     std::vector<std::uint8_t> pixels(16 * 16 * 4);
     EXPECT_EQ(dqj_render_rgba8(context, pixels.data(), 16, 16, 64, nestedCall, &attempt), DQJ_OK);
     EXPECT_EQ(attempt.status, DQJ_ERROR_BUSY);
+    EXPECT_EQ(dqj_context_destroy(context), DQJ_OK);
+}
+
+TEST(HostileC, AResultStructWithoutItsSizeIsRefusedUntouched) {
+    dqj_context context = nullptr;
+    ASSERT_EQ(dqj_context_create(&context), DQJ_OK);
+    ASSERT_EQ(dqj_context_set_bake_resolution(context, 16), DQJ_OK);
+    ASSERT_EQ(dqj_mesh_compute(context, nullptr, nullptr), DQJ_OK) << dqj_context_error(context);
+    // Zero-initialised (struct_size forgotten), or a size from some other struct: nothing is written.
+    for (const size_t size : {size_t(0), size_t(1), sizeof(dqj_bake_stats) - sizeof(double)}) {
+        dqj_bake_stats stats;
+        std::memset(&stats, 0xab, sizeof stats);
+        stats.struct_size = size;
+        EXPECT_EQ(dqj_bake_get_stats(context, &stats), DQJ_ERROR_INVALID_ARGUMENT) << size;
+        EXPECT_NE(std::string(dqj_context_error(context)).find("struct_size"), std::string::npos);
+        EXPECT_EQ(stats.struct_size, size);
+        EXPECT_EQ(stats.voxels_dense, 0xababababababababull) << "written although refused";
+    }
+    // Hosts probing for features they do not know get 0, never a crash.
+    EXPECT_EQ(dqj_has_feature(nullptr), 0);
+    EXPECT_EQ(dqj_has_feature(""), 0);
+    EXPECT_EQ(dqj_has_feature("VDB"), 0);
+    EXPECT_EQ(dqj_has_feature("vdb "), 0);
     EXPECT_EQ(dqj_context_destroy(context), DQJ_OK);
 }
 

@@ -12,8 +12,18 @@
  * - A context is busy while one of its calls runs: another call on it (from its progress
  *   callback, or from another thread) and dqj_context_destroy() return DQJ_ERROR_BUSY.
  * - Buffers are the caller's: sizes are queried first, then filled.
+ * - Result structs that may grow (dqj_bake_stats) start with `size_t struct_size`, which the
+ *   caller sets to sizeof the struct it compiled against (the DQJ_*_INIT macros do). The library
+ *   fills only what fits in that size, so a program built against an older header keeps
+ *   working when fields are added at the end; a size below the first version's is refused
+ *   (DQJ_ERROR_INVALID_ARGUMENT). Structs used as array elements (dqj_sample) are frozen.
+ * - What an optional part of the library offers is asked with dqj_has_feature(), never by
+ *   looking for symbols.
+ * - Progress callbacks return non-zero to go on and 0 to cancel, as the C++ API's
+ *   dqj::ProgressCallback returns true to go on and false to cancel.
  *
- * Thread safety: dqj_version*() and dqj_status_string() may be called from any thread.
+ * Thread safety: dqj_version*(), dqj_status_string() and dqj_has_feature() may be called from
+ * any thread.
  * Separate contexts are independent and may be used from different threads at the same
  * time. One context is used by one call at a time (a second call meanwhile is refused with
  * DQJ_ERROR_BUSY, not queued); its progress callback runs on the thread that called dqj_render*(),
@@ -56,6 +66,17 @@ typedef enum dqj_status {
 
 /* A short English name for a status ("invalid handle"); never NULL. */
 DQJ_API const char* dqj_status_string(dqj_status status);
+
+/* Whether the loaded library has an optional feature: 1 if it has, 0 if not (and for NULL or
+ * a name it does not know, such as one added by a later version). The functions of a feature
+ * the library lacks may be missing from it or refuse to work; ask before using them. */
+DQJ_API int dqj_has_feature(const char* name);
+/* dqj_bake_vdb, with dqj_context_set_bake_resolution, dqj_context_set_memory_limit, dqj_bake_get_stats */
+#define DQJ_FEATURE_VDB "vdb"
+/* dqj_mesh_*, with the same three */
+#define DQJ_FEATURE_MESH "mesh"
+/* keyframes (the parameters' "animation") and dqj_context_set_frame */
+#define DQJ_FEATURE_ANIMATION "animation"
 
 typedef enum dqj_variant {
     DQJ_VARIANT_PAPER = 0,         /* the paper's rule: a and b iterate independently */
@@ -102,7 +123,9 @@ DQJ_API dqj_status dqj_context_set_bailout(dqj_context context, double bailout);
 /* Axis names such as "a.s,a.i,a.j" (origin kept, rotations cleared). */
 DQJ_API dqj_status dqj_context_set_slice_axes(dqj_context context, const char* axes);
 
-/* The result for one point, as math.md specifies. */
+/* The result for one point, as math.md specifies. Frozen: it is an array element (the
+ * evaluate functions fill `count` of them), so its size and fields never change; a richer
+ * result would be a new struct with new functions. */
 typedef struct dqj_sample {
     int32_t n;  /* escape iteration; 0 = did not escape within N */
     double r;   /* norm used for the escape test, at exit */
@@ -118,8 +141,9 @@ DQJ_API dqj_status dqj_evaluate_points(dqj_context context, const double* points
 DQJ_API dqj_status dqj_evaluate_slice_points(dqj_context context, const double* points, size_t count, dqj_sample* out);
 
 /* Progress: called with the fraction done (0..1) on the calling thread: with 0 before the work
- * starts, a few times a second, and with 1 at the end;
- * return non-zero to cancel (the call then returns DQJ_ERROR_CANCELLED). */
+ * starts, a few times a second, and with 1 at the end. Return non-zero to go on, 0 to cancel
+ * (the call then returns DQJ_ERROR_CANCELLED): the convention of dqj::ProgressCallback, which
+ * returns true to go on and false to cancel. */
 typedef int (*dqj_progress_fn)(double fraction, void* user_data);
 
 /* Renders into a caller-owned RGBA8 (sRGB) buffer of `height` rows of `stride` bytes
@@ -176,14 +200,24 @@ DQJ_API dqj_status dqj_mesh_copy(dqj_context context, float* positions, float* n
  * all-or-nothing file behaviour as dqj_bake_vdb. */
 DQJ_API dqj_status dqj_mesh_write(dqj_context context, const char* path);
 
-/* What the context's last successful bake or mesh cost. */
+/* What the context's last successful bake or mesh cost (zeros before the first). It may gain
+ * fields at the end: set struct_size before the call (DQJ_BAKE_STATS_INIT does), e.g.
+ *   dqj_bake_stats stats = DQJ_BAKE_STATS_INIT;
+ * The library fills the fields that fit in struct_size, sets struct_size to the bytes it filled
+ * (less than the caller's size when the library is older than the caller's header) and leaves
+ * the rest untouched; a struct_size smaller than this first version's gives
+ * DQJ_ERROR_INVALID_ARGUMENT and fills nothing. */
 typedef struct dqj_bake_stats {
+    size_t struct_size;        /* in: sizeof(dqj_bake_stats) of the caller; out: the bytes filled */
     uint64_t voxels_evaluated; /* fractal evaluations, including the block tests */
     uint64_t voxels_dense;     /* voxels of the whole grid: what a dense bake evaluates */
     uint64_t active_voxels;    /* active voxels of the "surface" level set (bakes; 0 for meshes) */
     uint64_t estimated_bytes;  /* the memory estimate checked against the limit */
     double seconds;            /* wall-clock time */
 } dqj_bake_stats;
+/* An initialiser that sets struct_size (designated: C99, C++20). */
+#define DQJ_BAKE_STATS_INIT \
+    { .struct_size = sizeof(dqj_bake_stats) }
 DQJ_API dqj_status dqj_bake_get_stats(dqj_context context, dqj_bake_stats* out_stats);
 
 #ifdef __cplusplus

@@ -1,0 +1,184 @@
+#!/usr/bin/env bash
+# Checks the code against the project's style: clang-format (.clang-format) on C and C++,
+# ruff (ruff.toml: lint and format) on the Python of blender_addon/, scripts/ and tests/, and
+# clang-tidy (.clang-tidy) on C and C++ sources with build/compile_commands.json.
+#
+#   scripts/check-style.sh          the lines changed since the base: what a commit must keep clean
+#   scripts/check-style.sh --all    every file, every line (the tree is not reformatted yet)
+#   scripts/check-style.sh --fix    reformat the changed lines in place (clang-format, ruff format)
+#
+# The base is $DQJ_STYLE_BASE, else the merge-base of HEAD with main, or HEAD~1 when HEAD is
+# main itself or there is no main; changes not committed yet count too. ruff's lint and
+# clang-tidy report only findings on changed lines, so old code does not block new.
+# Tools: clang-format and clang-tidy from Debian (scripts/install-deps.sh), ruff from
+# scripts/ruff-env.sh; DQJ_CLANG_FORMAT, DQJ_CLANG_TIDY, DQJ_RUFF name others, DQJ_BUILD_DIR
+# another build tree. A missing tool is reported and skipped (DQJ_TEST_SKIPPED, as the tests
+# say it), except under CI=true, where it fails.
+# Exit status: 0 clean, 1 findings (or a missing tool in CI), 2 usage.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+mode=changed
+case "${1:-}" in
+  "") ;;
+  --all) mode=all ;;
+  --fix) mode=fix ;;
+  *) echo "usage: check-style.sh [--all | --fix]" >&2; exit 2 ;;
+esac
+
+clang_format="${DQJ_CLANG_FORMAT:-clang-format}"
+clang_tidy="${DQJ_CLANG_TIDY:-clang-tidy}"
+ruff="${DQJ_RUFF:-$(scripts/ruff-env.sh --print || true)}"
+build="${DQJ_BUILD_DIR:-build}"
+jobs="$(nproc)"
+
+failed=0
+skipped=""
+missing() {  # the project's rule for a missing tool (tests/script_support.cmake)
+  if [ "${CI:-}" = "true" ]; then
+    echo "check-style: $1 (CI=true: every check must run)" >&2
+    failed=1
+  else
+    echo "DQJ_TEST_SKIPPED: $1"
+    skipped=" (but not every check ran)"
+  fi
+}
+have() { command -v "$1" >/dev/null 2>&1; }
+
+is_cxx() { case "$1" in *.c | *.cpp | *.h | *.hpp) return 0 ;; esac; return 1; }
+is_python() { case "$1" in blender_addon/*.py | scripts/*.py | tests/*.py) return 0 ;; esac; return 1; }
+
+# The files to check and, unless --all, the lines changed in each ("FIRST:LAST" ranges).
+declare -A ranges=()
+files=()
+if [ "$mode" = all ]; then
+  while IFS= read -r file; do files+=("$file"); done < <(git ls-files)
+  base="(none: every line)"
+else
+  base="${DQJ_STYLE_BASE:-}"
+  if [ -z "$base" ]; then
+    base="$(git merge-base HEAD main 2>/dev/null || true)"
+    if [ -z "$base" ] || [ "$base" = "$(git rev-parse HEAD)" ]; then
+      base="$(git rev-parse --verify -q HEAD~1 || true)"
+    fi
+  fi
+  if [ -z "$base" ]; then
+    echo "check-style: no base commit to compare with (set DQJ_STYLE_BASE, or use --all): nothing checked"
+    exit 0
+  fi
+  while IFS= read -r file; do
+    [ -f "$file" ] || continue
+    files+=("$file")
+    # New lines of each hunk, from "@@ -a,b +c,d @@" (d = 0: lines only removed).
+    ranges[$file]="$(git diff -U0 --no-color "$base" -- "$file" |
+      sed -n 's/^@@ -[0-9,]* +\([0-9]*\)\(,\([0-9]*\)\)\? @@.*/\1 \3/p' |
+      awk '{ n = ($2 == "") ? 1 : $2; if (n > 0) printf "%d:%d ", $1, $1 + n - 1 }')"
+  done < <(git diff --name-only --diff-filter=d "$base"; git ls-files --others --exclude-standard)
+  for file in $(git ls-files --others --exclude-standard); do
+    ranges[$file]="1:$(($(wc -l < "$file") + 1))"
+  done
+fi
+cxx=() python=()
+for file in "${files[@]}"; do
+  if is_cxx "$file"; then cxx+=("$file"); elif is_python "$file"; then python+=("$file"); fi
+done
+echo "check-style: ${#cxx[@]} C/C++ and ${#python[@]} Python files, against ${base}"
+
+# clang-format: --lines for each changed range; whole files with --all.
+if [ ${#cxx[@]} -gt 0 ]; then
+  if ! have "$clang_format"; then
+    missing "clang-format is not installed (scripts/install-deps.sh installs it)"
+  else
+    for file in "${cxx[@]}"; do
+      arguments=()
+      if [ "$mode" != all ]; then
+        [ -n "${ranges[$file]// /}" ] || continue
+        for range in ${ranges[$file]}; do arguments+=("--lines=$range"); done
+      fi
+      if [ "$mode" = fix ]; then
+        "$clang_format" -i "${arguments[@]}" "$file"
+      elif ! "$clang_format" --dry-run --Werror "${arguments[@]}" "$file"; then
+        failed=1
+      fi
+    done
+  fi
+fi
+
+# ruff: lint findings on changed lines; format per changed range (ruff formats one range a run).
+if [ ${#python[@]} -gt 0 ]; then
+  if [ -z "$ruff" ] || ! have "$ruff"; then
+    missing "ruff is not installed (scripts/ruff-env.sh installs it)"
+  else
+    if [ "$mode" = all ]; then
+      "$ruff" check --quiet --output-format concise "${python[@]}" || failed=1
+      "$ruff" format --check "${python[@]}" || failed=1
+    else
+      findings="$("$ruff" check --quiet --output-format concise --exit-zero "${python[@]}")"
+      while IFS= read -r finding; do
+        [ -n "$finding" ] || continue
+        file="${finding%%:*}" rest="${finding#*:}" line="${rest%%:*}"
+        for range in ${ranges[$file]:-}; do
+          if [ "$line" -ge "${range%%:*}" ] && [ "$line" -le "${range##*:}" ]; then
+            echo "$finding"
+            failed=1
+            break
+          fi
+        done
+      done <<< "$findings"
+      for file in "${python[@]}"; do
+        for range in ${ranges[$file]:-}; do
+          if [ "$mode" = fix ]; then
+            "$ruff" format --quiet --range "${range/:/-}" "$file"
+          elif ! "$ruff" format --quiet --diff --range "${range/:/-}" "$file"; then
+            failed=1
+          fi
+        done
+      done
+    fi
+  fi
+fi
+
+# clang-tidy: the sources in compile_commands.json; with a line filter unless --all.
+if [ ${#cxx[@]} -gt 0 ] && [ "$mode" != fix ]; then
+  if ! have "$clang_tidy"; then
+    missing "clang-tidy is not installed (scripts/install-deps.sh installs it)"
+  elif [ ! -f "$build/compile_commands.json" ]; then
+    missing "$build/compile_commands.json is missing (scripts/build.sh makes it)"
+  else
+    sources=()
+    for file in "${cxx[@]}"; do
+      case "$file" in *.c | *.cpp) grep -q "\"file\": \"$PWD/$file\"" "$build/compile_commands.json" && sources+=("$file") ;; esac
+    done
+    filter=()
+    if [ "$mode" != all ]; then
+      entries=()
+      for file in "${cxx[@]}"; do
+        pairs=()
+        for range in ${ranges[$file]:-}; do pairs+=("[${range%%:*},${range##*:}]"); done
+        [ ${#pairs[@]} -eq 0 ] || entries+=("{\"name\":\"$file\",\"lines\":[$(IFS=,; echo "${pairs[*]}")]}")
+      done
+      # An empty list would mean every line: name a line no file has instead.
+      [ ${#entries[@]} -gt 0 ] || entries+=('{"name":"-","lines":[[1,1]]}')
+      filter=("--line-filter=[$(IFS=,; echo "${entries[*]}")]")
+    fi
+    if [ ${#sources[@]} -gt 0 ]; then
+      started=$SECONDS
+      report="$(mktemp)"
+      printf '%s\n' "${sources[@]}" |
+        xargs -P "$jobs" -I{} "$clang_tidy" -p "$build" --quiet "${filter[@]}" {} >"$report" 2>/dev/null || true
+      if grep -q ": \(warning\|error\):" "$report"; then
+        cat "$report"
+        echo "check-style: clang-tidy: $(grep -c ": \(warning\|error\):" "$report") findings"
+        failed=1
+      fi
+      rm -f "$report"
+      echo "check-style: clang-tidy checked ${#sources[@]} sources in $((SECONDS - started)) s"
+    fi
+  fi
+fi
+
+if [ "$failed" -ne 0 ]; then
+  echo "check-style: FAILED (scripts/check-style.sh --fix reformats the changed lines; README, Style)" >&2
+  exit 1
+fi
+echo "check-style: clean$skipped"
