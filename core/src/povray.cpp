@@ -263,7 +263,8 @@ void writeTexture(std::ostringstream& out, const Params& params, bool chainAvail
         // the palette's first colour stands in for the orbit colouring.
         const glm::dvec3 colour = material.coloring == Coloring::Solid ? material.color : paletteColour(material, 0.0);
         if (material.coloring != Coloring::Solid && material.palette.size() > 1 && !chainAvailable)
-            out << "// N is beyond dqjulia.inc's limit: the orbit colouring is replaced by the palette's first colour\n";
+            out << "// N is beyond dqjulia.inc's limit: the orbit colouring is replaced by the palette's first "
+                   "colour\n";
         out << "#declare Fractal_Pigment = pigment { rgb " << vector3(colour, false) << " };\n";
     }
     out << "#declare Fractal_Texture = texture {\n  pigment { Fractal_Pigment }\n";

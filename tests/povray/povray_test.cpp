@@ -1,8 +1,9 @@
 // dqjulia.inc and `dqjulia povray` checked with the real POV-Ray 3.7: the include's functions
 // equal the core's distance estimate, its bounds and stretch equal the core's, its colouring
 // (smooth count, trap scale, palette colours) equals the core's coloring unit, in the include's
-// macros and in generated scenes, it parses without warnings, the chain of functions costs O(N), and generated scenes draw the silhouette
-// `dqjulia render` draws (intersection over union). Every test spawns `povray`.
+// macros and in generated scenes, it parses without warnings, the chain of functions costs
+// O(N), and generated scenes draw the silhouette `dqjulia render` draws (intersection over
+// union). Every test spawns `povray`.
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
@@ -295,8 +296,8 @@ TEST_F(Povray, IncludeFunctionsEqualTheCoresDistanceEstimate) {
             expected[key + ".de"] = {test.name, escape.de, true};
             expected[key + ".trap"] = {test.name, escape.trap, false};
             // DQJ_Iteration_Function is the core's smooth count over N (coloring.hpp).
-            expected[key + ".iterations"] = {test.name, dqj::smoothIterations(test.fractal, escape) / test.fractal.iterations,
-                                             false};
+            const double smooth = dqj::smoothIterations(test.fractal, escape);
+            expected[key + ".iterations"] = {test.name, smooth / test.fractal.iterations, false};
         }
     }
     const Outcome result = parse(scene.str());
@@ -432,8 +433,8 @@ TEST_F(Povray, IncludeColouringEqualsTheCoresColoringUnit) {
         expectedValues[id + ".scale"] = dqj::trapScale(test.fractal);
         for (std::size_t p = 0; p < testPalettes().size(); ++p) {
             const char* coloring = p % 2 == 0 ? "trap" : "iterations";
-            scene << "#declare P" << id << "_" << p << " = function { DQJ_Orbit_Pigment(" << common << ", \"" << coloring
-                  << "\", " << paletteArray(testPalettes()[p]) << ") };\n";
+            scene << "#declare P" << id << "_" << p << " = function { DQJ_Orbit_Pigment(" << common << ", \""
+                  << coloring << "\", " << paletteArray(testPalettes()[p]) << ") };\n";
         }
         const auto bounds = dqj::containingBounds(test.fractal, test.slice);
         ASSERT_TRUE(bounds) << test.name;
@@ -443,7 +444,8 @@ TEST_F(Povray, IncludeColouringEqualsTheCoresColoringUnit) {
             ++(escape.n == 0 ? inside : escaped);
             const std::string pov = number(point.x) + ", " + number(point.y) + ", " + number(-point.z);
             scene << "#debug concat(\"VALUE " << key << ".trap \", Print(CT" << id << "(" << pov << ")), \"\\n\")\n"
-                  << "#debug concat(\"VALUE " << key << ".iterations \", Print(CI" << id << "(" << pov << ")), \"\\n\")\n";
+                  << "#debug concat(\"VALUE " << key << ".iterations \", Print(CI" << id << "(" << pov
+                  << ")), \"\\n\")\n";
             // The include clamps the value to [0, 1], as the core's palette does.
             expectedValues[key + ".trap"] =
                 std::clamp(dqj::coloringValue(dqj::Coloring::Trap, test.fractal, escape), 0.0, 1.0);
@@ -481,8 +483,9 @@ TEST_F(Povray, IncludeColouringEqualsTheCoresColoringUnit) {
     const double worstColour = compareColours(colours, expectedColours, kColourTolerance);
     EXPECT_GT(escaped, 100u);
     EXPECT_GT(inside, 10u);
-    std::cout << "[ povray   ] colouring at " << escaped + inside << " points of " << cases.size() << " configurations ("
-              << escaped << " escaped, " << inside << " inside): largest difference of trap scale and colouring values "
+    std::cout << "[ povray   ] colouring at " << escaped + inside << " points of " << cases.size()
+              << " configurations (" << escaped << " escaped, " << inside
+              << " inside): largest difference of trap scale and colouring values "
               << worstValue << ", of palette colours (" << colours.size() << ") " << worstColour << "\n";
     RecordProperty("max_colour_difference", number(worstColour));
 }
@@ -498,7 +501,8 @@ TEST_F(Povray, GeneratedScenesColourAsTheCore) {
         {"trap, default palette", R"({"material": {"coloring": "trap"}})"},
         {"iterations, 4 colours, dual",
          R"({"fractal": {"variant": "dual", "iterations": 12, "c": [-0.2, 0.6, 0.2, 0, 0, 0, 0, 0]},
-             "material": {"coloring": "iterations", "palette": [[1, 0, 0], [0.25, 0.5, 0.75], [0, 1, 0], [0.1, 0.1, 0.1]]}})"},
+             "material": {"coloring": "iterations",
+                          "palette": [[1, 0, 0], [0.25, 0.5, 0.75], [0, 1, 0], [0.1, 0.1, 0.1]]}})"},
         {"solid", R"({"material": {"coloring": "solid", "color": [0.3, 0.4, 0.5]}})"},
         {"trap, one colour", R"({"material": {"coloring": "trap", "palette": [[0.7, 0.2, 0.9]]}})"},
     };
@@ -519,7 +523,8 @@ TEST_F(Povray, GeneratedScenesColourAsTheCore) {
         for (const glm::dvec3& point : samplePoints(bounds, random, 40)) {
             const std::string key = id + "." + std::to_string(expected.size());
             text += debugColour("RGB", key, "Fractal_Colour", point);
-            expected[key] = dqj::orbitColour(params.material, params.fractal, dqj::evaluate(params.fractal, slice.map(point)));
+            const dqj::Escape escape = dqj::evaluate(params.fractal, slice.map(point));
+            expected[key] = dqj::orbitColour(params.material, params.fractal, escape);
         }
         write("colour" + id + ".pov", text);
         const Outcome result = povray("+W1 +H1 -F -A +Icolour" + id + ".pov");
@@ -528,8 +533,8 @@ TEST_F(Povray, GeneratedScenesColourAsTheCore) {
         const std::vector<std::string> lines = tagged(result.log, "RGB");
         ASSERT_EQ(lines.size(), expected.size()) << scenes[index].name << "\n" << result.log;
         const double difference = compareColours(lines, expected, kColourTolerance);
-        std::cout << "[ povray   ] generated scene, " << scenes[index].name << ": largest colour difference " << difference
-                  << " at " << lines.size() << " points\n";
+        std::cout << "[ povray   ] generated scene, " << scenes[index].name << ": largest colour difference "
+                  << difference << " at " << lines.size() << " points\n";
         worst = std::max(worst, difference);
         points += lines.size();
     }

@@ -399,7 +399,8 @@ glsl::DqjMaterial toShader(const dqj::Material& material) {
 
 double largestDifference(const glm::dvec3& core, const glm::vec3& shader) {
     double worst = 0.0;
-    for (int channel = 0; channel < 3; ++channel) worst = std::max(worst, std::abs(core[channel] - double(shader[channel])));
+    for (int channel = 0; channel < 3; ++channel)
+        worst = std::max(worst, std::abs(core[channel] - double(shader[channel])));
     return worst;
 }
 
@@ -460,7 +461,8 @@ TEST(ShaderShading, GlslColouringMatchesCore) {
                     const float shaderSmooth = glsl::dqj_smooth_iterations(e, iterations, float(fractal.bailout));
                     worstSmooth = std::max(worstSmooth, std::abs(double(shaderSmooth) - smooth) / iterations);
                     for (const auto& palette : palettes) {
-                        for (dqj::Coloring coloring : {dqj::Coloring::Solid, dqj::Coloring::Iterations, dqj::Coloring::Trap}) {
+                        for (dqj::Coloring coloring :
+                             {dqj::Coloring::Solid, dqj::Coloring::Iterations, dqj::Coloring::Trap}) {
                             dqj::Material material;
                             material.palette = palette;
                             material.coloring = coloring;
@@ -515,7 +517,8 @@ TEST(ShaderShading, GlslPhongMatchesCore) {
             material.shininess = shininess;
             const glsl::DqjMaterial m = toShader(material);
             const glm::dvec3 base = glm::dvec3(glm::vec3(positive(random), positive(random), positive(random)));
-            const glm::dvec3 radiance = glm::dvec3(glm::vec3(1.5 * positive(random), positive(random), positive(random)));
+            const glm::dvec3 radiance =
+                glm::dvec3(glm::vec3(1.5 * positive(random), positive(random), positive(random)));
             const double open = std::vector<double>{1.0, 0.5, 0.0}[sample % 3];
             const glm::dvec3 normal = direction(), toLight = direction(), toEye = direction();
             const double facing = glm::dot(normal, toLight);
