@@ -1,9 +1,10 @@
 """The viewport preview: the set ray-marched by a GLSL shader inside each DQ Julia object's
 bounds, drawn from a SpaceView3D draw handler, updating live as parameters change.
 
-The shader is shaders/dqjulia_de.glsl (the DE and sphere tracer, the same code the test suite
-compiles as C++ and compares with the core) followed by shaders/preview_frag.glsl; its
-interface is shaders/preview.interface. What the shader cannot compute cheaply comes from the
+The shader is shaders/dqjulia_de.glsl (the DE and sphere tracer) and shaders/dqjulia_shading.glsl
+(the core's colouring and Phong terms, coloring.hpp), the code the test suite compiles as C++
+and compares with the core, followed by shaders/preview_frag.glsl; its interface is
+shaders/preview.interface. What the shader cannot compute cheaply comes from the
 core, once per change of parameters (`state_for`): validation of the document, the bounds,
 whether the slice is provably empty (and why), and r_K; slicing.py turns the slice's rotations
 into the 8-D axes. Marching costs one ray per pixel of the cube around the bounds; the
@@ -286,7 +287,7 @@ def uniforms(obj, state, view_matrix, projection_matrix, viewport_height):
     params.ints = (ctypes.c_int32 * 4)(native.VARIANTS.index(fractal["variant"]), int(fractal["iterations"]),
                                        ["solid", "iterations", "trap"].index(material["coloring"]), palette_size)
     params.floats = (ctypes.c_float * 4)(float(fractal["bailout"]), float(state.stretch),
-                                         0.65 * state.containment_radius, 1.0 if clipped else 0.0)
+                                         state.containment_radius, 1.0 if clipped else 0.0)
     push = {"dqj_mvp": mvp, "dqj_eye": eye4, "dqj_footprint": footprint}
     return push, params, model_view.determinant() < 0.0
 

@@ -16,6 +16,7 @@
 #include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
 
+#include "dqjulia/coloring.hpp"
 #include "parallel_progress.hpp"
 
 namespace dqj {
@@ -221,16 +222,11 @@ RenderResult renderVoxels(const Params& params, const std::string& vdbPath, cons
                             colour += settings.backgroundBottom * (1.0 - mix) + settings.backgroundTop * mix;
                             continue;
                         }
-                        glm::dvec3 shaded = material.ambient * material.color;
-                        for (const Light& light : params.lights) {
-                            const glm::dvec3 l = glm::normalize(light.direction);
-                            const double facing = glm::dot(hit.normal, l);
-                            if (facing <= 0.0) continue;
-                            const glm::dvec3 reflected = 2.0 * facing * hit.normal - l;
-                            const double highlight = std::pow(std::max(0.0, glm::dot(reflected, -direction)), material.shininess);
-                            shaded += (material.diffuse * facing * material.color + material.specular * highlight) *
-                                      light.color * light.intensity;
-                        }
+                        // The renderer's Phong terms (coloring.hpp) on the solid colour, without occlusion.
+                        glm::dvec3 shaded = phongAmbient(material, material.color, 1.0);
+                        for (const Light& light : params.lights)
+                            shaded += phongLight(material, material.color, hit.normal, glm::normalize(light.direction),
+                                                 -direction, light.color * light.intensity, 1.0);
                         colour += shaded;
                         surface += shaded;
                         ++hits;

@@ -2,6 +2,7 @@
 #include "dqjulia/bake.hpp"
 #include "dqjulia/version.h"
 #include "dqjulia/batch.hpp"
+#include "dqjulia/coloring.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -22,7 +23,6 @@
 #include <openvdb/tools/LevelSetUtil.h>
 
 #include "atomic_file.hpp"
-#include "dqjulia/render.hpp"
 #include "level_set.hpp"
 #include "parallel_progress.hpp"
 
@@ -67,14 +67,8 @@ MemoryModel bakeMemoryModel(const BakeSettings& bake) {
     return model;
 }
 
-/// The smooth escape count n + 1 - log2(ln r / ln R); N for points that did not escape.
-double smoothIterations(const Fractal& fractal, const Escape& escape) {
-    if (escape.n == 0 || !(escape.r > 1.0)) return fractal.iterations;
-    return escape.n + 1.0 - std::log2(std::log(escape.r) / std::log(fractal.bailout));
-}
-
 /// The attribute grids ("color", "trap", "iterations") on the level set's active voxels: one
-/// fractal evaluation per voxel of the narrow band.
+/// fractal evaluation per voxel of the narrow band; colour and smooth count from coloring.hpp.
 void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, const ProgressCallback& progress,
                        BakeStats& stats, openvdb::GridPtrVec& grids) {
     const bool color = hasGrid(params.bake, BakeGrid::Color);

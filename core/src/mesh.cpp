@@ -17,7 +17,7 @@
 #include "atomic_file.hpp"
 #include "dqjulia/batch.hpp"
 #include "dqjulia/image.hpp"
-#include "dqjulia/render.hpp"
+#include "dqjulia/coloring.hpp"
 #include "level_set.hpp"
 #include "parallel_progress.hpp"
 
@@ -243,7 +243,7 @@ Mesh bakeMesh(const Params& params, const BakeOptions& options, const ProgressCa
     removeDegenerateFaces(mesh);
     mesh.normals = vertexNormals(mesh);
 
-    // Colours: the material's colouring of the orbit at each vertex, as the renderer shades it.
+    // Colours: the material's colouring of the orbit at each vertex (orbitColour, coloring.hpp), as the renderer's.
     if (params.bake.meshColors) {
         mesh.colors.resize(mesh.positions.size());
         const Slice slice = params.slice.effective();

@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "atomic_file.hpp"
+#include "dqjulia/coloring.hpp"
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/render.hpp"
 #include "parallel_progress.hpp"
@@ -243,29 +244,30 @@ void writeBackground(std::ostringstream& out, const Params& params, const Camera
 
 void writeTexture(std::ostringstream& out, const Params& params, bool chainAvailable) {
     const Material& material = params.material;
-    out << "// ---- Material: the core's Phong terms (the paper's equation) and colouring\n";
+    out << "// ---- Material: the core's Phong terms (the paper's equation) and colouring (coloring.hpp)\n";
     const bool palette = material.coloring != Coloring::Solid && material.palette.size() > 1 && chainAvailable;
     if (palette) {
-        const char* name = material.coloring == Coloring::Trap ? "trap" : "iterations";
-        out << "#declare Fractal_Coloring = DQJ_Coloring_Function(Fractal_C, Fractal_Variant, Fractal_N, Fractal_R, "
-               "Fractal_Slice, \""
-            << name << "\");\n";
+        out << "#declare Fractal_Palette = array[" << material.palette.size() << "] {";
+        for (std::size_t index = 0; index < material.palette.size(); ++index)
+            out << (index ? ", " : "") << vector3(material.palette[index]);
+        out << "};\n";
     }
-    out << "#declare Fractal_Texture = texture {\n";
+    // The surface's colour: the core's orbitColour (coloring.hpp) through the include's port of it.
     if (palette) {
-        out << "  pigment {\n    function { Fractal_Coloring(x, y, z) }\n    color_map {\n";
-        const std::size_t count = material.palette.size();
-        for (std::size_t index = 0; index < count; ++index)
-            out << "      [" << shortNumber(double(index) / double(count - 1)) << " rgb "
-                << vector3(material.palette[index], false) << "]\n";
-        out << "    }\n  }\n";
+        const char* name = material.coloring == Coloring::Trap ? "trap" : "iterations";
+        out << "#declare Fractal_Pigment = DQJ_Orbit_Pigment(Fractal_C, Fractal_Variant, Fractal_N, Fractal_R, "
+               "Fractal_Slice, \""
+            << name << "\", Fractal_Palette);\n";
     } else {
-        glm::dvec3 colour = material.color;
-        if (material.coloring != Coloring::Solid && !material.palette.empty()) colour = material.palette.front();
+        // Solid, or a palette of one colour: the colour every point gets. Beyond the include's N,
+        // the palette's first colour stands in for the orbit colouring.
+        const glm::dvec3 colour = material.coloring == Coloring::Solid ? material.color : paletteColour(material, 0.0);
         if (material.coloring != Coloring::Solid && material.palette.size() > 1 && !chainAvailable)
-            out << "  // N is beyond dqjulia.inc's limit: the orbit colouring is replaced by the palette's first colour\n";
-        out << "  pigment { rgb " << vector3(colour, false) << " }\n";
+            out << "// N is beyond dqjulia.inc's limit: the orbit colouring is replaced by the palette's first "
+                   "colour\n";
+        out << "#declare Fractal_Pigment = pigment { rgb " << vector3(colour, false) << " };\n";
     }
+    out << "#declare Fractal_Texture = texture {\n  pigment { Fractal_Pigment }\n";
     out << "  finish { ambient " << shortNumber(material.ambient) << " diffuse " << shortNumber(material.diffuse)
         << " phong " << shortNumber(material.specular) << " phong_size " << shortNumber(material.shininess) << " }\n"
         << "}\n\n";

@@ -10,16 +10,15 @@
 // scalar engine answers each query with evaluate(), the reference; both run the same logic.
 #include "dqjulia/render.hpp"
 #include "dqjulia/batch.hpp"
+#include "dqjulia/coloring.hpp"
 #include "dqjulia/inspect.hpp"
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <iomanip>
 #include <limits>
 #include <numbers>
-#include <sstream>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -438,24 +437,18 @@ private:
         if (!marching) finishShading();
     }
 
-    /// Phong (the paper's equation) with occlusion on the ambient term and soft shadows.
+    /// Phong (the paper's equation, coloring.hpp) with occlusion on the ambient term and soft shadows.
     void finishShading() {
         const Scene& scene = *scene_;
         const Material& material = scene.material_;
         const glm::dvec3 base = scene.baseColour(trace_.escape.escape());
-        glm::dvec3 colour = material.ambient * open_ * base;
+        glm::dvec3 colour = phongAmbient(material, base, open_);
         const glm::dvec3 toEye = -direction_;
-        const double diffuseOcclusion = 0.7 + 0.3 * open_;  // creases also lose some direct light
         for (std::size_t index = 0; index < scene.lights_.size(); ++index) {
             const auto& light = scene.lights_[index];
-            const double facing = glm::dot(normal_, light.direction);
-            if (facing <= 0.0) continue;
             const double lit = material.shadows ? shadows_[index].lit : 1.0;
             if (lit <= 0.0) continue;
-            const glm::dvec3 reflected = 2.0 * facing * normal_ - light.direction;
-            const double highlight = std::pow(std::max(0.0, glm::dot(reflected, toEye)), material.shininess);
-            colour += (material.diffuse * facing * diffuseOcclusion * base + material.specular * highlight) *
-                      light.radiance * lit;
+            colour += phongLight(material, base, normal_, light.direction, toEye, light.radiance, open_) * lit;
         }
         colour_ = colour;
         stage_ = Stage::Done;
@@ -631,60 +624,11 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
 
 }  // namespace
 
-namespace {
-
-glm::dvec3 paletteAt(const Material& material, double value) {
-    const auto& colours = material.palette;
-    if (colours.empty()) return material.color;
-    if (colours.size() == 1 || !(value > 0.0)) return colours.front();
-    if (value >= 1.0) return colours.back();
-    const double position = value * static_cast<double>(colours.size() - 1);
-    const auto index = static_cast<std::size_t>(position);
-    const double fraction = position - static_cast<double>(index);
-    return colours[index] * (1.0 - fraction) + colours[index + 1] * fraction;
-}
-
-}  // namespace
-
-glm::dvec3 orbitColour(const Material& material, const Fractal& fractal, const Escape& escape) {
-    switch (material.coloring) {
-        case Coloring::Solid: return material.color;
-        case Coloring::Iterations: {
-            if (escape.n == 0 || !(escape.r > 1.0)) return paletteAt(material, 1.0);
-            // Smooth escape count: the fraction of an iteration by which r overshot R.
-            const double smooth = escape.n + 1.0 - std::log2(std::log(escape.r) / std::log(fractal.bailout));
-            return paletteAt(material, smooth / fractal.iterations);
-        }
-        case Coloring::Trap: {
-            // The orbit's closest approach to 0 ranges over [0, r_K(c_a)] and is mostly below half
-            // of it on the surface; scaling by 0.65 r_K spreads the default set's values over the
-            // whole palette.
-            return paletteAt(material, escape.trap / (0.65 * containmentRadius(fractal.c.a)));
-        }
-    }
-    return material.color;
-}
-
 glm::dvec3 CameraFrame::rayDirection(double px, double py) const {
     const double aspect = static_cast<double>(width) / height;
     const double x = (2.0 * px / width - 1.0) * tanHalfFov * aspect;
     const double y = (1.0 - 2.0 * py / height) * tanHalfFov;  // image rows go down, `up` goes up
     return glm::normalize(forward + x * right + y * up);
-}
-
-Bounds renderBounds(const Params& params) {
-    if (params.bounds) return *params.bounds;
-    const Slice slice = params.slice.effective();
-    const auto bounds = containingBounds(params.fractal, slice);
-    if (bounds) return *bounds;
-    std::ostringstream message;
-    message << std::setprecision(4) << "slice: the slice misses the containment region (every orbit with |a| > r_K = "
-            << containmentRadius(params.fractal.c.a) << " escapes";
-    if (params.fractal.variant != Variant::Dual)
-        message << ", and every orbit with |b| > r_K = " << containmentRadius(params.fractal.c.b);
-    message << "), so the set is empty in this slice whatever the iteration count; move the slice origin "
-               "closer to 0 or set explicit \"bounds\"";
-    throw ParamError("slice", message.str());
 }
 
 CameraFrame frameCamera(const Params& params, const Bounds& bounds) {

@@ -1,8 +1,10 @@
-// Slices: axis names, rotations, stretch and containing bounds.
+// Slices: axis names, rotations, stretch, containing bounds and the bounds everything starts from.
 #include "dqjulia/slice.hpp"
+#include "dqjulia/params.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <numbers>
 #include <sstream>
 #include <stdexcept>
@@ -228,6 +230,21 @@ std::optional<Bounds> containingBounds(const Fractal& fractal, const Slice& slic
         if (fit.bounded && (!best || fit.bounds.radius < best->radius)) best = fit.bounds;
     }
     return best;
+}
+
+Bounds renderBounds(const Params& params) {
+    if (params.bounds) return *params.bounds;
+    const Slice slice = params.slice.effective();
+    const auto bounds = containingBounds(params.fractal, slice);
+    if (bounds) return *bounds;
+    std::ostringstream message;
+    message << std::setprecision(4) << "slice: the slice misses the containment region (every orbit with |a| > r_K = "
+            << containmentRadius(params.fractal.c.a) << " escapes";
+    if (params.fractal.variant != Variant::Dual)
+        message << ", and every orbit with |b| > r_K = " << containmentRadius(params.fractal.c.b);
+    message << "), so the set is empty in this slice whatever the iteration count; move the slice origin "
+               "closer to 0 or set explicit \"bounds\"";
+    throw ParamError("slice", message.str());
 }
 
 }  // namespace dqj

@@ -15,7 +15,7 @@
 
 #include "dqjulia/ball_bound.hpp"
 #include "dqjulia/batch.hpp"
-#include "dqjulia/render.hpp"
+#include "dqjulia/slice.hpp"
 #include "parallel_progress.hpp"
 
 namespace dqj {

@@ -5,7 +5,10 @@
 
 1. The GLSL preview, drawn offscreen with the camera of a core render, against that render's
    alpha (the core's dqj_render_rgba8, which `dqjulia render` calls; and the CLI itself when
-   --cli is given): the silhouettes' overlap (IoU).
+   --cli is given): the silhouettes' overlap (IoU), and the colour: the mean linear colour of
+   the pixels both cover, preview against core (occlusion and shadows off, which the preview
+   does not draw; normals by central differences, as the preview's), within
+   --max-colour-difference per channel.
 2. The draw handler in the real 3-D viewport: a window screenshot with the preview on against
    one with it off; the changed pixels against the offscreen preview of the viewport's view.
 3. Bake Volume through the modal operator: Blender keeps running its timers while the worker
@@ -33,6 +36,11 @@ from common import check, report  # noqa: E402
 def extra_arguments(parser):
     parser.add_argument("--screenshots", default="", help="save README screenshots to this folder")
     parser.add_argument("--min-iou", type=float, default=0.98)
+    # The preview marches, takes normals and shades in float on the GPU, the core in double, so
+    # single pixels may differ where the surface has fine detail; the mean colour of the two
+    # pictures differed by 1e-4 (linear RGB, per channel) under llvmpipe, so 0.005 leaves room for
+    # other drivers while a wrong palette, trap scale or Phong term (0.02 and more) fails.
+    parser.add_argument("--max-colour-difference", type=float, default=0.005)
 
 
 ARGS = common.arguments(extra_arguments)
@@ -69,9 +77,13 @@ def perspective(fov_degrees, aspect, near, far):
 
 
 def offscreen_preview(obj, view, projection, width, height):
-    """The preview drawn offscreen: (RGBA floats bottom-up, coverage mask top-down)."""
+    """The preview drawn offscreen: (RGBA floats bottom-up, coverage mask top-down). Half floats,
+    so the linear colour is not rounded to 8 bits."""
     import gpu
-    offscreen = gpu.types.GPUOffScreen(width, height)
+    try:
+        offscreen = gpu.types.GPUOffScreen(width, height, format="RGBA16F")
+    except (TypeError, ValueError):
+        offscreen = gpu.types.GPUOffScreen(width, height)
     try:
         with offscreen.bind():
             framebuffer = gpu.state.active_framebuffer_get()
@@ -107,11 +119,36 @@ def save_mask(path, mask, width, height):
     bpy.data.images.remove(image)
 
 
-def core_mask(document, width, height):
-    """The core renderer's coverage (alpha > 0.5) for the document, top-down."""
+def core_render(document, width, height):
+    """The core renderer's coverage (alpha > 0.5) for the document, top-down, and its pixels
+    (RGBA8, sRGB colour)."""
     with native.Context(document) as context:
         pixels, _warning = context.render_rgba8(width, height)
-    return [pixels[4 * i + 3] > 127 for i in range(width * height)]
+    return [pixels[4 * i + 3] > 127 for i in range(width * height)], pixels
+
+
+def srgb_to_linear(value):
+    """An 8-bit sRGB value (0..255) as linear colour: the inverse of the core's linearToSrgb8."""
+    encoded = value / 255.0
+    return encoded / 12.92 if encoded <= 0.04045 else ((encoded + 0.055) / 1.055) ** 2.4
+
+
+def mean_colours(preview_rgba, core_pixels, preview_mask, core_mask, width, height):
+    """Mean linear RGB of the preview and of the core over the pixels both cover, and how many."""
+    preview_sum = [0.0, 0.0, 0.0]
+    core_sum = [0.0, 0.0, 0.0]
+    count = 0
+    for index in range(width * height):
+        if not (preview_mask[index] and core_mask[index]):
+            continue
+        row, column = divmod(index, width)
+        base = 4 * ((height - 1 - row) * width + column)  # the preview's rows are bottom-up
+        for channel in range(3):
+            preview_sum[channel] += preview_rgba[base + channel]
+            core_sum[channel] += srgb_to_linear(core_pixels[4 * index + channel])
+        count += 1
+    count_or_one = max(1, count)
+    return [x / count_or_one for x in preview_sum], [x / count_or_one for x in core_sum], count
 
 
 def cli_mask(document, width, height):
@@ -184,17 +221,21 @@ def setup_scene():
 
 def step_offscreen_iou(obj):
     cases = [
-        ("default (paper, N=15)", {}),
-        ("dual, N=30, turned slice", {"variant": "dual", "iterations": 30, "c_a": (-0.2, 0.6, 0.2, 0.0),
-                                      "c_b": (0.0, 0.0, 0.0, 0.0), "rotation": ("a.j", "a.k", 35.0)}),
+        ("default (paper, N=15, trap colouring)", {}),
+        ("dual, N=30, turned slice, iterations colouring",
+         {"variant": "dual", "iterations": 30, "c_a": (-0.2, 0.6, 0.2, 0.0), "c_b": (0.0, 0.0, 0.0, 0.0),
+          "rotation": ("a.j", "a.k", 35.0), "coloring": "iterations"}),
     ]
     s = obj.dqjulia
     for name, change in cases:
         with native.Context() as context:
             props.from_document(s, context.params())
-        for key in ("variant", "iterations", "c_a", "c_b"):
+        for key in ("variant", "iterations", "c_a", "c_b", "coloring"):
             if key in change:
                 setattr(s, key, change[key])
+        # The preview draws no occlusion or shadows, and takes normals by central differences
+        # (the core's "auto" takes analytic ones for dual: 2.5% brighter on average here).
+        s.occlusion, s.shadows, s.normals = 0.0, False, "central"
         if "rotation" in change:
             rotation = s.rotations.add()
             rotation.first, rotation.second, rotation.degrees = change["rotation"]
@@ -204,18 +245,25 @@ def step_offscreen_iou(obj):
         s.width, s.height, s.samples = WIDTH, HEIGHT, 1
         s.preview_max_steps = s.max_steps  # the preview marches as far as the core
         document = props.to_document(s)
-        expected = core_mask(document, WIDTH, HEIGHT)
+        expected, core_pixels = core_render(document, WIDTH, HEIGHT)
         # The core's camera is in the slice's (the object's local) coordinates; the viewport's in
         # the world's: the object is turned (Add DQ Julia's y-up convention).
         view = look_at(eye, target, up) @ obj.matrix_world.inverted()
         projection = perspective(fov, WIDTH / HEIGHT, 0.05, 100.0)
-        drew, _rgba, drawn = offscreen_preview(obj, view, projection, WIDTH, HEIGHT)
+        drew, rgba, drawn = offscreen_preview(obj, view, projection, WIDTH, HEIGHT)
         check(drew, "%s: the preview shader compiled and drew (%s)" % (name, preview.shader_error() or "no error"))
         value = common.iou(drawn, expected)
         RESULTS["iou " + name] = value
         check(sum(expected) > 0.05 * WIDTH * HEIGHT, "%s: the core render covers %d pixels" % (name, sum(expected)))
         check(value >= ARGS.min_iou, "%s: preview vs core render silhouette IoU %.4f (>= %.2f)"
               % (name, value, ARGS.min_iou))
+        preview_mean, core_mean, both = mean_colours(rgba, core_pixels, drawn, expected, WIDTH, HEIGHT)
+        difference = max(abs(a - b) for a, b in zip(preview_mean, core_mean))
+        RESULTS["colour difference " + name] = difference
+        check(both > 0.05 * WIDTH * HEIGHT and difference <= ARGS.max_colour_difference,
+              "%s: mean colour over %d pixels, preview (%.4f, %.4f, %.4f) vs core (%.4f, %.4f, %.4f): largest "
+              "channel difference %.4f (<= %.3f)" % ((name, both) + tuple(preview_mean) + tuple(core_mean)
+                                                   + (difference, ARGS.max_colour_difference)))
         slug = name.split(" ")[0].strip(",")
         save_mask(os.path.join(ARGS.work, "mask_preview_%s.png" % slug), drawn, WIDTH, HEIGHT)
         save_mask(os.path.join(ARGS.work, "mask_core_%s.png" % slug), expected, WIDTH, HEIGHT)

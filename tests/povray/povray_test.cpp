@@ -1,12 +1,15 @@
 // dqjulia.inc and `dqjulia povray` checked with the real POV-Ray 3.7: the include's functions
-// equal the core's distance estimate, its bounds and stretch equal the core's, it parses without
-// warnings, the chain of functions costs O(N), and generated scenes draw the silhouette
-// `dqjulia render` draws (intersection over union). Every test spawns `povray`.
+// equal the core's distance estimate, its bounds and stretch equal the core's, its colouring
+// (smooth count, trap scale, palette colours) equals the core's coloring unit, in the include's
+// macros and in generated scenes, it parses without warnings, the chain of functions costs
+// O(N), and generated scenes draw the silhouette `dqjulia render` draws (intersection over
+// union). Every test spawns `povray`.
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -20,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "dqjulia/coloring.hpp"
 #include "dqjulia/image.hpp"
 #include "dqjulia/povray.hpp"
 #include "dqjulia/version.h"
@@ -63,21 +67,23 @@ std::string sliceArray(const dqj::Slice& slice) {
     return text + "}";
 }
 
-/// Scene preamble: the include from the source tree and a tiny object (so POV-Ray does not
-/// warn about an empty scene).
-const char* kPreamble =
-    "#version 3.7;\n"
-    "global_settings { assumed_gamma 1.0 }\n"
-    "#include \"dqjulia.inc\"\n"
-    "sphere { 0, 1 pigment { rgb 1 } }\n"
-    "camera { location <0, 0, -5> look_at 0 }\n"
-    // A number printed with 17 significant digits: mantissa and decimal exponent.
+/// A number printed with 17 significant digits: mantissa and decimal exponent.
+const char* kPrintMacro =
     "#macro Print(V)\n"
     "  #if (V = 0)\n    \"0\"\n  #else\n"
     "    #local E = floor(log(abs(V)));\n"
     "    concat(str(V / pow(10, E), 0, 16), \"e\", str(E, 0, 0))\n"
     "  #end\n"
     "#end\n";
+
+/// Scene preamble: the include from the source tree and a tiny object (so POV-Ray does not
+/// warn about an empty scene), and Print.
+const std::string kPreamble = std::string(
+    "#version 3.7;\n"
+    "global_settings { assumed_gamma 1.0 }\n"
+    "#include \"dqjulia.inc\"\n"
+    "sphere { 0, 1 pigment { rgb 1 } }\n"
+    "camera { location <0, 0, -5> look_at 0 }\n") + kPrintMacro;
 
 class Povray : public ::testing::Test {
 protected:
@@ -177,12 +183,6 @@ std::string unwrapped(const std::string& log) {
 double relativeDifference(double a, double b) {
     if (a == b) return 0.0;
     return std::abs(a - b) / std::max(std::abs(a), std::abs(b));
-}
-
-/// The core's smooth escape count / N as the include's "iterations" colouring computes it.
-double smoothIterations(const dqj::Fractal& fractal, const dqj::Escape& escape) {
-    if (escape.n == 0) return 1.0;
-    return (escape.n + 1.0 - std::log2(std::log(escape.r) / std::log(fractal.bailout))) / fractal.iterations;
 }
 
 struct Case {
@@ -295,7 +295,9 @@ TEST_F(Povray, IncludeFunctionsEqualTheCoresDistanceEstimate) {
                   << args << ")), \" \", Print(I" << id << "(" << args << ")), \"\\n\")\n";
             expected[key + ".de"] = {test.name, escape.de, true};
             expected[key + ".trap"] = {test.name, escape.trap, false};
-            expected[key + ".iterations"] = {test.name, smoothIterations(test.fractal, escape), false};
+            // DQJ_Iteration_Function is the core's smooth count over N (coloring.hpp).
+            const double smooth = dqj::smoothIterations(test.fractal, escape);
+            expected[key + ".iterations"] = {test.name, smooth / test.fractal.iterations, false};
         }
     }
     const Outcome result = parse(scene.str());
@@ -357,6 +359,188 @@ TEST_F(Povray, IncludeFunctionsEqualTheCoresDistanceEstimate) {
     RecordProperty("max_relative_de_difference", number(worstDistance));
 }
 
+/// A pigment's colour at a POV-Ray point, at parse time: "#debug TAG key r g b".
+std::string debugColour(const std::string& tag, const std::string& key, const std::string& pigment,
+                        const glm::dvec3& slicePoint) {
+    const std::string args = number(slicePoint.x) + ", " + number(slicePoint.y) + ", " + number(-slicePoint.z);
+    return "#declare Colour = " + pigment + "(" + args + ");\n#debug concat(\"" + tag + " " + key +
+           " \", Print(Colour.red), \" \", Print(Colour.green), \" \", Print(Colour.blue), \"\\n\")\n";
+}
+
+std::string paletteArray(const std::vector<glm::dvec3>& palette) {
+    std::string text = "array[" + std::to_string(palette.size()) + "] {";
+    for (std::size_t index = 0; index < palette.size(); ++index)
+        text += (index ? ", <" : "<") + number(palette[index].x) + ", " + number(palette[index].y) + ", " +
+                number(palette[index].z) + ">";
+    return text + "}";
+}
+
+/// Largest channel difference of "key r g b" lines against the expected colours.
+double compareColours(const std::vector<std::string>& lines, const std::map<std::string, glm::dvec3>& expected,
+                      double tolerance) {
+    double worst = 0.0;
+    for (const std::string& line : lines) {
+        std::istringstream fields(line);
+        std::string key;
+        glm::dvec3 colour;
+        fields >> key >> colour.x >> colour.y >> colour.z;
+        EXPECT_FALSE(fields.fail()) << line;
+        const glm::dvec3& want = expected.at(key);
+        const double difference = std::max({std::abs(colour.x - want.x), std::abs(colour.y - want.y),
+                                            std::abs(colour.z - want.z)});
+        worst = std::max(worst, difference);
+        EXPECT_LE(difference, tolerance) << key << ": POV-Ray " << line << ", core " << want.x << " " << want.y << " "
+                                         << want.z;
+    }
+    return worst;
+}
+
+// POV-Ray holds colours in single precision: a colour channel is good to about 1e-7.
+constexpr double kColourTolerance = 1e-6;
+
+const std::vector<std::vector<glm::dvec3>>& testPalettes() {
+    static const std::vector<std::vector<glm::dvec3>> palettes{
+        dqj::Material{}.palette,  // the default, 3 colours
+        {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.2, 0.9, 0.7}, {1, 1, 1}},
+        {{0.3, 0.6, 0.1}},
+    };
+    return palettes;
+}
+
+TEST_F(Povray, IncludeColouringEqualsTheCoresColoringUnit) {
+    std::mt19937 random(20261201);
+    std::ostringstream scene;
+    scene << kPreamble
+          << "#macro Origin_Set(S)\n  #local T = S;\n  #declare T[0][0] = 0.1; #declare T[0][3] = 0.05; "
+             "#declare T[0][5] = 0.2;\n  T\n#end\n";
+    std::map<std::string, double> expectedValues;
+    std::map<std::string, glm::dvec3> expectedColours;
+    std::vector<Case> cases = agreementCases();
+    cases.pop_back();  // not the 400-deep chain: each pigment below is a chain of its own
+    std::size_t escaped = 0, inside = 0;
+    for (std::size_t index = 0; index < cases.size(); ++index) {
+        const Case& test = cases[index];
+        const std::string id = std::to_string(index);
+        const std::string common = "C" + id + ", V" + id + ", " + std::to_string(test.fractal.iterations) + ", " +
+                                   number(test.fractal.bailout) + ", S" + id;
+        scene << "// " << test.name << "\n"
+              << "#declare C" << id << " = " << array8(dqj::toVec8(test.fractal.c)) << ";\n"
+              << "#declare S" << id << " = " << test.sliceSdl << ";\n"
+              << "#declare V" << id << " = \"" << dqj::variantName(test.fractal.variant) << "\";\n"
+              << "#debug concat(\"VALUE " << id << ".scale \", Print(DQJ_Trap_Scale(C" << id << ")), \"\\n\")\n"
+              << "#declare CT" << id << " = DQJ_Coloring_Function(" << common << ", \"trap\");\n"
+              << "#declare CI" << id << " = DQJ_Coloring_Function(" << common << ", \"iterations\");\n";
+        expectedValues[id + ".scale"] = dqj::trapScale(test.fractal);
+        for (std::size_t p = 0; p < testPalettes().size(); ++p) {
+            const char* coloring = p % 2 == 0 ? "trap" : "iterations";
+            scene << "#declare P" << id << "_" << p << " = function { DQJ_Orbit_Pigment(" << common << ", \""
+                  << coloring << "\", " << paletteArray(testPalettes()[p]) << ") };\n";
+        }
+        const auto bounds = dqj::containingBounds(test.fractal, test.slice);
+        ASSERT_TRUE(bounds) << test.name;
+        for (const glm::dvec3& point : samplePoints(*bounds, random, 30)) {
+            const std::string key = id + "." + std::to_string(escaped + inside);
+            const dqj::Escape escape = dqj::evaluate(test.fractal, test.slice.map(point));
+            ++(escape.n == 0 ? inside : escaped);
+            const std::string pov = number(point.x) + ", " + number(point.y) + ", " + number(-point.z);
+            scene << "#debug concat(\"VALUE " << key << ".trap \", Print(CT" << id << "(" << pov << ")), \"\\n\")\n"
+                  << "#debug concat(\"VALUE " << key << ".iterations \", Print(CI" << id << "(" << pov
+                  << ")), \"\\n\")\n";
+            // The include clamps the value to [0, 1], as the core's palette does.
+            expectedValues[key + ".trap"] =
+                std::clamp(dqj::coloringValue(dqj::Coloring::Trap, test.fractal, escape), 0.0, 1.0);
+            expectedValues[key + ".iterations"] =
+                std::clamp(dqj::coloringValue(dqj::Coloring::Iterations, test.fractal, escape), 0.0, 1.0);
+            for (std::size_t p = 0; p < testPalettes().size(); ++p) {
+                dqj::Material material;
+                material.coloring = p % 2 == 0 ? dqj::Coloring::Trap : dqj::Coloring::Iterations;
+                material.palette = testPalettes()[p];
+                const std::string colourKey = key + "." + std::to_string(p);
+                scene << debugColour("RGB", colourKey, "P" + id + "_" + std::to_string(p), point);
+                expectedColours[colourKey] = dqj::orbitColour(material, test.fractal, escape);
+            }
+        }
+    }
+    const Outcome result = parse(scene.str());
+    ASSERT_EQ(result.exitCode, 0) << result.log;
+    EXPECT_TRUE(problems(result.log).empty()) << result.log;
+
+    double worstValue = 0.0;
+    const std::vector<std::string> values = tagged(result.log, "VALUE");
+    ASSERT_EQ(values.size(), expectedValues.size()) << result.log;
+    for (const std::string& line : values) {
+        std::istringstream fields(line);
+        std::string key;
+        double value = 0.0;
+        fields >> key >> value;
+        const double want = expectedValues.at(key);
+        const double difference = std::abs(value - want);
+        worstValue = std::max(worstValue, difference);
+        EXPECT_LE(difference, 1e-9 * std::max(1.0, std::abs(want))) << line << " core " << number(want);
+    }
+    const std::vector<std::string> colours = tagged(result.log, "RGB");
+    ASSERT_EQ(colours.size(), expectedColours.size()) << result.log;
+    const double worstColour = compareColours(colours, expectedColours, kColourTolerance);
+    EXPECT_GT(escaped, 100u);
+    EXPECT_GT(inside, 10u);
+    std::cout << "[ povray   ] colouring at " << escaped + inside << " points of " << cases.size()
+              << " configurations (" << escaped << " escaped, " << inside
+              << " inside): largest difference of trap scale and colouring values "
+              << worstValue << ", of palette colours (" << colours.size() << ") " << worstColour << "\n";
+    RecordProperty("max_colour_difference", number(worstColour));
+}
+
+TEST_F(Povray, GeneratedScenesColourAsTheCore) {
+    // The scene `dqjulia povray` writes declares Fractal_Pigment; its colour at points of the
+    // slice, evaluated by POV-Ray while parsing, against the core's orbitColour.
+    struct Scene {
+        std::string name;
+        std::string json;
+    };
+    const std::vector<Scene> scenes = {
+        {"trap, default palette", R"({"material": {"coloring": "trap"}})"},
+        {"iterations, 4 colours, dual",
+         R"({"fractal": {"variant": "dual", "iterations": 12, "c": [-0.2, 0.6, 0.2, 0, 0, 0, 0, 0]},
+             "material": {"coloring": "iterations",
+                          "palette": [[1, 0, 0], [0.25, 0.5, 0.75], [0, 1, 0], [0.1, 0.1, 0.1]]}})"},
+        {"solid", R"({"material": {"coloring": "solid", "color": [0.3, 0.4, 0.5]}})"},
+        {"trap, one colour", R"({"material": {"coloring": "trap", "palette": [[0.7, 0.2, 0.9]]}})"},
+    };
+    std::mt19937 random(7);
+    double worst = 0.0;
+    std::size_t points = 0;
+    for (std::size_t index = 0; index < scenes.size(); ++index) {
+        const std::string id = std::to_string(index);
+        const std::string paramsPath = write("colour" + id + ".json", scenes[index].json);
+        const dqj::Params params = dqj::loadParams(paramsPath);
+        std::string err;
+        ASSERT_EQ(cli("povray -q -p '" + paramsPath + "' -o '" + path("colour" + id + ".pov") + "'", &err), 0) << err;
+        std::string text = readFile(path("colour" + id + ".pov"));
+        text += std::string(kPrintMacro) + "#declare Fractal_Colour = function { pigment { Fractal_Pigment } };\n";
+        const dqj::Slice slice = params.slice.effective();
+        const dqj::Bounds bounds = dqj::renderBounds(params);
+        std::map<std::string, glm::dvec3> expected;
+        for (const glm::dvec3& point : samplePoints(bounds, random, 40)) {
+            const std::string key = id + "." + std::to_string(expected.size());
+            text += debugColour("RGB", key, "Fractal_Colour", point);
+            const dqj::Escape escape = dqj::evaluate(params.fractal, slice.map(point));
+            expected[key] = dqj::orbitColour(params.material, params.fractal, escape);
+        }
+        write("colour" + id + ".pov", text);
+        const Outcome result = povray("+W1 +H1 -F -A +Icolour" + id + ".pov");
+        ASSERT_EQ(result.exitCode, 0) << result.log;
+        EXPECT_TRUE(problems(result.log).empty()) << result.log;
+        const std::vector<std::string> lines = tagged(result.log, "RGB");
+        ASSERT_EQ(lines.size(), expected.size()) << scenes[index].name << "\n" << result.log;
+        const double difference = compareColours(lines, expected, kColourTolerance);
+        std::cout << "[ povray   ] generated scene, " << scenes[index].name << ": largest colour difference "
+                  << difference << " at " << lines.size() << " points\n";
+        worst = std::max(worst, difference);
+        points += lines.size();
+    }
+    RecordProperty("max_scene_colour_difference", number(worst));
+}
+
 TEST_F(Povray, IncludeParsesCleanlyWithEveryMacro) {
     const std::string scene = std::string(kPreamble) +
                               "#include \"dqjulia.inc\"  // a second include is a no-op (include guard)\n"
@@ -380,6 +564,10 @@ TEST_F(Povray, IncludeParsesCleanlyWithEveryMacro) {
                               "#declare F4 = DQJ_Scene_Function(C, \"dual\", 6, 4, S2, DQJ_Max_Step);\n"
                               "#declare F5 = DQJ_Coloring_Function(C, \"paper\", 6, 4, S0, \"trap\");\n"
                               "#declare F6 = DQJ_Coloring_Function(C, \"paper\", 6, 4, S0, \"iterations\");\n"
+                              "#declare TS = DQJ_Trap_Scale(C);\n"
+                              "#declare Pal = array[2] {<1, 0, 0>, <0, 0, 1>};\n"
+                              "#declare Pg = DQJ_Orbit_Pigment(C, \"dual\", 6, 4, S2, \"iterations\", Pal);\n"
+                              "#declare Pg2 = pigment { function { F6(x, y, z) } DQJ_Palette_Colour_Map(Pal) };\n"
                               "#declare P = DQJ_To_Pov(<1, 2, 3>);\n"
                               "#declare Q = F1(0.1, 0.2, 0.3) + F2(0.1, 0.2, 0.3) + F3(0, 0, 0) + F4(1, 1, 1) + "
                               "F5(0, 0, 0) + F6(0, 0, 0);\n"

@@ -16,6 +16,8 @@
 //   (eps_float * |dz|) reaches 1e-3 of |z| before the escape. Such points must also stay rare.
 // - The sphere tracer (dqj_march) is compared as a picture: the silhouette it finds along
 //   the core camera's rays against the alpha of the core's own render (IoU).
+// - The preview's colouring and Phong terms (dqjulia_shading.glsl) against coloring.hpp: see
+//   the section at the end.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -26,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "dqjulia/coloring.hpp"
 #include "dqjulia/estimate.hpp"
 #include "dqjulia/params.hpp"
 #include "dqjulia/render.hpp"
@@ -345,6 +348,213 @@ TEST(ShaderMarch, SilhouetteMatchesCoreRender) {
         std::printf("[GLSL march] %s: silhouette IoU with the core render %.4f\n", item.name.c_str(), iou);
         EXPECT_GT(iou, 0.97) << item.name;
     }
+}
+
+// ---- The preview's colouring and Phong terms (dqjulia_shading.glsl) against the core's
+// (coloring.hpp), in float against double on the same inputs.
+//
+// Both sides get the same escape results (the core's, rounded to float, as the GPU would hold
+// them) and the same vectors, so what differs is float against double arithmetic:
+// - the colouring value (smooth count / N, trap / trap scale) to a few float roundings, and the
+//   palette colour, linear in it, to those times the palette's slope (at most 3 colours a unit);
+// - Phong: the highlight max(0, R.V)^s turns a relative rounding e of R.V into about s * e, so
+//   the tolerance is 16 eps_float (1 + s) of the terms' size. The one discontinuity of the
+//   model, a light grazing the surface (N.L = 0, where the highlight switches on), is kept out.
+
+double roundToFloat(double value) { return double(float(value)); }
+
+/// The escape as the shader holds it, and the core's escape rounded the same way.
+glsl::DqjEscape toShader(const dqj::Escape& e) {
+    glsl::DqjEscape result;
+    result.n = e.n;
+    result.r = float(e.r);
+    result.ra = float(e.ra);
+    result.rb = float(e.rb);
+    result.de = float(std::min(e.de, 1e30));
+    result.trap = float(e.trap);
+    return result;
+}
+
+dqj::Escape rounded(dqj::Escape e) {
+    e.r = roundToFloat(e.r);
+    e.ra = roundToFloat(e.ra);
+    e.rb = roundToFloat(e.rb);
+    e.trap = roundToFloat(e.trap);
+    return e;
+}
+
+/// The preview's material (preview.py fills the same fields from the document).
+glsl::DqjMaterial toShader(const dqj::Material& material) {
+    glsl::DqjMaterial m{};
+    m.coloring = int(material.coloring);
+    m.color = glm::vec3(material.color);
+    const std::size_t count = std::min<std::size_t>(material.palette.size(), 4);
+    for (std::size_t index = 0; index < 4; ++index)
+        m.palette[int(index)] = glm::vec4(glm::vec3(material.palette[std::min(index, count - 1)]), 1.0f);
+    m.palette_size = int(count);
+    m.phong = glm::vec4(float(material.ambient), float(material.diffuse), float(material.specular),
+                        float(material.shininess));
+    return m;
+}
+
+double largestDifference(const glm::dvec3& core, const glm::vec3& shader) {
+    double worst = 0.0;
+    for (int channel = 0; channel < 3; ++channel)
+        worst = std::max(worst, std::abs(core[channel] - double(shader[channel])));
+    return worst;
+}
+
+/// Random start points in the 8-D ball of 1.1 r_K of each part, as samplePoints' (unrounded).
+std::vector<dqj::DualQuat> shadingPoints(const dqj::Fractal& fractal, int count, std::mt19937& random) {
+    std::normal_distribution<double> gaussian;
+    std::uniform_real_distribution<double> uniform(0.0, 1.0);
+    auto ball = [&](double radius) {
+        double v[4], length = 0.0;
+        for (double& x : v) {
+            x = gaussian(random);
+            length += x * x;
+        }
+        const double scale = radius * std::pow(uniform(random), 0.25) / std::sqrt(length);
+        return dqj::makeQuat(v[0] * scale, v[1] * scale, v[2] * scale, v[3] * scale);
+    };
+    std::vector<dqj::DualQuat> points;
+    for (int index = 0; index < count; ++index)
+        points.push_back({ball(1.1 * dqj::containmentRadius(fractal.c.a)),
+                          index % 2 ? ball(1.1 * dqj::containmentRadius(fractal.c.b)) : dqj::makeQuat(0, 0, 0, 0)});
+    return points;
+}
+
+TEST(ShaderShading, GlslColouringMatchesCore) {
+    const std::vector<dqj::Vec8> constants{{-0.10, 0.8, -0.26, 0.15, -0.23, -0.38, -0.86, 0.64},
+                                           {-0.39054, -0.58679, 0, 0, 0, 0.5632, 0, 0.05},
+                                           {-0.2, 0.6, 0.2, 0, 0, 0, 0, 0}};
+    const std::vector<std::vector<glm::dvec3>> palettes{
+        dqj::Material{}.palette,  // the default: 3 colours
+        {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 1, 1}},
+        {{0.1, 0.2, 0.3}, {0.9, 0.8, 0.1}},
+        {{0.4, 0.5, 0.6}},
+    };
+    std::mt19937 random(1313);
+    double worst[3] = {0.0, 0.0, 0.0};  // solid, iterations, trap: largest colour difference
+    double worstSmooth = 0.0, worstTrapScale = 0.0;
+    long escaped = 0, inside = 0, compared = 0;
+    for (const dqj::Vec8& c : constants) {
+        for (dqj::Variant variant : {dqj::Variant::Paper, dqj::Variant::PaperCoupled, dqj::Variant::Dual}) {
+            for (int iterations : {8, 30}) {
+                dqj::Fractal fractal;
+                dqj::Vec8 floatC = c;
+                for (double& x : floatC) x = roundToFloat(x);
+                fractal.c = dqj::toDualQuat(floatC);
+                fractal.variant = variant;
+                fractal.iterations = iterations;
+                fractal.bailout = std::max(4.0, std::ceil(dqj::minimumBailout(fractal) * 100.0) / 100.0);
+                fractal.bailout = roundToFloat(fractal.bailout);
+                // The preview passes r_K (from the core) and the shader scales it.
+                const float trapScale = glsl::dqj_trap_scale(float(dqj::containmentRadius(fractal.c.a)));
+                worstTrapScale = std::max(worstTrapScale, std::abs(double(trapScale) - dqj::trapScale(fractal)) /
+                                                              dqj::trapScale(fractal));
+                for (const dqj::DualQuat& z : shadingPoints(fractal, 500, random)) {
+                    const dqj::Escape escape = rounded(dqj::evaluate(fractal, z));
+                    const glsl::DqjEscape e = toShader(escape);
+                    ++(escape.n == 0 ? inside : escaped);
+                    const double smooth = dqj::smoothIterations(fractal, escape);
+                    const float shaderSmooth = glsl::dqj_smooth_iterations(e, iterations, float(fractal.bailout));
+                    worstSmooth = std::max(worstSmooth, std::abs(double(shaderSmooth) - smooth) / iterations);
+                    for (const auto& palette : palettes) {
+                        for (dqj::Coloring coloring :
+                             {dqj::Coloring::Solid, dqj::Coloring::Iterations, dqj::Coloring::Trap}) {
+                            dqj::Material material;
+                            material.palette = palette;
+                            material.coloring = coloring;
+                            const glm::dvec3 core = dqj::orbitColour(material, fractal, escape);
+                            const glm::vec3 shader = glsl::dqj_orbit_colour(toShader(material), e, iterations,
+                                                                            float(fractal.bailout), trapScale);
+                            const double difference = largestDifference(core, shader);
+                            worst[int(coloring)] = std::max(worst[int(coloring)], difference);
+                            // Float roundings of the value, times the palette's slope (<= 3 a unit).
+                            EXPECT_LE(difference, 64.0 * kEpsFloat)
+                                << "coloring " << int(coloring) << " n=" << escape.n << " r=" << escape.r
+                                << " trap=" << escape.trap << " palette of " << palette.size();
+                            ++compared;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    std::printf("[GLSL colouring] %ld colours compared (%ld escaped, %ld inside points): largest colour difference "
+                "solid %.3g, iterations %.3g, trap %.3g; smooth count / N %.3g, trap scale (relative) %.3g\n",
+                compared, escaped, inside, worst[0], worst[1], worst[2], worstSmooth, worstTrapScale);
+    EXPECT_LE(worst[0], kEpsFloat);  // the material colour, rounded to float
+    EXPECT_LE(worstSmooth, 16.0 * kEpsFloat);
+    EXPECT_LE(worstTrapScale, 2.0 * kEpsFloat);
+    EXPECT_GT(escaped, 1000);
+    EXPECT_GT(inside, 200);
+}
+
+TEST(ShaderShading, GlslPhongMatchesCore) {
+    std::mt19937 random(2424);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    std::uniform_real_distribution<double> positive(0.0, 1.0);
+    auto direction = [&] {
+        for (;;) {
+            const glm::dvec3 v(unit(random), unit(random), unit(random));
+            const double length = glm::length(v);
+            if (length > 0.1 && length <= 1.0) {
+                const glm::vec3 f(v / length);  // the shader's float vector; the core gets the same values
+                return glm::dvec3(f);
+            }
+        }
+    };
+    double worstAmbient = 0.0, worstLight = 0.0, worstRatio = 0.0;
+    long lit = 0, behind = 0, grazing = 0;
+    for (double shininess : {1.0, 8.0, 24.0, 100.0}) {
+        for (int sample = 0; sample < 4000; ++sample) {
+            dqj::Material material;
+            material.ambient = roundToFloat(positive(random));
+            material.diffuse = roundToFloat(positive(random));
+            material.specular = roundToFloat(positive(random));
+            material.shininess = shininess;
+            const glsl::DqjMaterial m = toShader(material);
+            const glm::dvec3 base = glm::dvec3(glm::vec3(positive(random), positive(random), positive(random)));
+            const glm::dvec3 radiance =
+                glm::dvec3(glm::vec3(1.5 * positive(random), positive(random), positive(random)));
+            const double open = std::vector<double>{1.0, 0.5, 0.0}[sample % 3];
+            const glm::dvec3 normal = direction(), toLight = direction(), toEye = direction();
+            const double facing = glm::dot(normal, toLight);
+            if (std::abs(facing) < 1e-5) {  // the highlight switches on at N.L = 0 (file comment)
+                ++grazing;
+                continue;
+            }
+            ++(facing > 0.0 ? lit : behind);
+
+            const glm::dvec3 ambient = dqj::phongAmbient(material, base, open);
+            const glm::vec3 shaderAmbient = glsl::dqj_phong_ambient(m, glm::vec3(base), float(open));
+            worstAmbient = std::max(worstAmbient, largestDifference(ambient, shaderAmbient));
+            EXPECT_LE(largestDifference(ambient, shaderAmbient), 4.0 * kEpsFloat);
+
+            const glm::dvec3 core = dqj::phongLight(material, base, normal, toLight, toEye, radiance, open);
+            const glm::vec3 shader = glsl::dqj_phong_light(m, glm::vec3(base), glm::vec3(normal), glm::vec3(toLight),
+                                                          glm::vec3(toEye), glm::vec3(radiance), float(open));
+            // The terms' size: what the light could give at most here.
+            const double size = (material.diffuse + material.specular) * std::max({radiance.x, radiance.y, radiance.z});
+            const double difference = largestDifference(core, shader);
+            worstLight = std::max(worstLight, difference);
+            const double ratio = difference / (kEpsFloat * (1.0 + shininess) * std::max(size, 1e-3));
+            worstRatio = std::max(worstRatio, ratio);
+            EXPECT_LE(ratio, 16.0) << "shininess " << shininess << " facing " << facing << " core " << core.x << " "
+                                   << core.y << " " << core.z << " shader " << shader.x << " " << shader.y << " "
+                                   << shader.z;
+            if (facing < 0.0) {
+                EXPECT_EQ(glm::length(shader), 0.0f);
+            }
+        }
+    }
+    std::printf("[GLSL Phong] %ld lit, %ld behind (%ld grazing left out): largest difference ambient %.3g, one light "
+                "%.3g; max difference / (eps_float (1 + s) size) = %.2f\n",
+                lit, behind, grazing, worstAmbient, worstLight, worstRatio);
+    EXPECT_GT(lit, 5000);
+    EXPECT_GT(behind, 5000);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 // shader_shims.hpp - compiles the add-on's shader sources as C++ against GLM, so the test
-// suite can hold them equal to the core.
+// suite can hold them equal to the core: the GLSL distance estimate and sphere tracer
+// (dqjulia_de.glsl), the GLSL colouring and Phong terms (dqjulia_shading.glsl), the OSL density.
 //
 // GLM mirrors GLSL's types and functions, so the GLSL needs nothing but names in scope; the
 // OSL code writes a quaternion as float + vector and marks output parameters with DQJ_OUT,
@@ -16,11 +17,14 @@ using glm::vec4;
 using glm::dot;
 using glm::length;
 using glm::log;
+using glm::log2;
 using glm::max;
 using glm::min;
 using glm::normalize;
+using glm::pow;
 using glm::sqrt;
 #include DQJ_GLSL_DE_SOURCE
+#include DQJ_GLSL_SHADING_SOURCE
 }  // namespace glsl
 
 namespace osl {

@@ -1,31 +1,12 @@
 // preview_frag.glsl - the viewport preview: one ray a pixel through the back faces of the
 // cube around the bounds, marched by dqj_march (dqjulia_de.glsl, which precedes this file),
-// shaded like the core's renderer without its shadows and occlusion, and written with its
-// true depth so the preview sits among the scene's other objects.
+// coloured and shaded by the core's colouring and Phong terms (dqjulia_shading.glsl, the port of
+// coloring.hpp, which also precedes it) without the renderer's shadows and occlusion, and
+// written with its true depth so the preview sits among the scene's other objects.
 //
 // dqj_eye: w = 1, the eye in object coordinates (perspective); w = 0, the viewing direction
 // (orthographic). dqj_footprint: a pixel's size at distance t, footprint.x * t + footprint.y.
 // Everything else is in the uniform buffer `dqj` (preview_params.glsl).
-
-vec3 dqj_palette_colour(float value) {
-    int count = dqj.ints.w;
-    if (count <= 1 || !(value > 0.0)) return vec3(dqj.palette[0]);
-    if (value >= 1.0) return vec3(dqj.palette[count - 1]);
-    float position = value * float(count - 1);
-    int index = int(position);
-    float fraction = position - float(index);
-    return mix(vec3(dqj.palette[index]), vec3(dqj.palette[index + 1]), fraction);
-}
-
-vec3 dqj_base_colour(DqjEscape e) {
-    if (dqj.ints.z == 0) return dqj.color.rgb;
-    if (dqj.ints.z == 1) {
-        if (e.n == 0 || !(e.r > 1.0)) return dqj_palette_colour(1.0);
-        float smooth_count = float(e.n) + 1.0 - log2(log(e.r) / log(dqj.floats.x));
-        return dqj_palette_colour(smooth_count / float(dqj.ints.y));
-    }
-    return dqj_palette_colour(e.trap / dqj.floats.z);
-}
 
 void main() {
     DqjFractal f;
@@ -64,18 +45,19 @@ void main() {
     vec3 p = origin + trace.t * direction;
     float eps = dqj_epsilon(m, trace.t);
     vec3 normal = dqj_normal(f, m, trace, p, direction, eps);
-    vec3 base = dqj_base_colour(trace.escape);
-    vec3 colour = dqj.phong.x * base;
-    vec3 to_eye = -direction;
-    for (int i = 0; i < 2; ++i) {
-        vec3 light = dqj.lights[2 * i].xyz;
-        vec3 radiance = dqj.lights[2 * i + 1].xyz;
-        float facing = dot(normal, light);
-        if (facing <= 0.0) continue;
-        vec3 reflected = 2.0 * facing * normal - light;
-        float highlight = pow(max(0.0, dot(reflected, to_eye)), dqj.phong.w);
-        colour += (dqj.phong.y * facing * base + dqj.phong.z * highlight) * radiance;
-    }
+    DqjMaterial material;
+    material.coloring = dqj.ints.z;
+    material.color = vec3(dqj.color);
+    material.palette = dqj.palette;
+    material.palette_size = dqj.ints.w;
+    material.phong = dqj.phong;
+    float trap_scale = dqj_trap_scale(dqj.floats.z);
+    vec3 base = dqj_orbit_colour(material, trace.escape, f.iterations, f.bailout, trap_scale);
+    // No ambient occlusion (open = 1) and no shadows: the renderer's terms otherwise.
+    vec3 colour = dqj_phong_ambient(material, base, 1.0);
+    for (int i = 0; i < 2; ++i)
+        colour += dqj_phong_light(material, base, normal, dqj.lights[2 * i].xyz, -direction, dqj.lights[2 * i + 1].xyz,
+                                  1.0);
 
     vec4 clip = dqj_mvp * vec4(p, 1.0);
     gl_FragDepth = clamp(0.5 * clip.z / clip.w + 0.5, 0.0, 1.0);

@@ -14,5 +14,6 @@ struct DqjPreviewParams {
     vec4 phong;     // ambient, diffuse, specular, shininess
     ivec4 ints;     // variant (0 paper, 1 paper-coupled, 2 dual), iterations, colouring (0 solid,
                     // 1 iterations, 2 trap), palette size
-    vec4 floats;    // bailout, stretch, trap scale, clipped (1 = the sphere clips an extrusion)
+    vec4 floats;    // bailout, stretch, r_K(c_a) (for the trap's scale), clipped (1 = the sphere clips an
+                    // extrusion)
 };

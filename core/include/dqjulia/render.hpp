@@ -2,8 +2,8 @@
 //
 // Rays start where they enter the bounding sphere (radius r_K, math.md) and step by
 // stepFactor * min(DE / stretch, maxStep) until the DE falls below the pixel footprint
-// (times `detail`). Shading: Phong (the paper's equation, several lights), ambient
-// occlusion and soft shadows from the DE, orbit colouring, background gradient,
+// (times `detail`). Shading: Phong (the paper's equation, several lights) and orbit colouring
+// from coloring.hpp, ambient occlusion and soft shadows from the DE, background gradient,
 // samples x samples anti-aliasing. Work is split in tiles over TBB threads; the rays of a tile
 // march together, their points evaluated many at a time by the SIMD batch kernel (batch.hpp).
 // Cost: about width * height * samples^2 * (steps per ray) * N quaternion iterations.
@@ -21,7 +21,7 @@
 
 namespace dqj {
 
-/// The camera resolved against the bounds: eye, orthonormal frame and field of view.
+/// The camera resolved against the bounds (renderBounds, slice.hpp): eye, orthonormal frame and field of view.
 struct CameraFrame {
     glm::dvec3 eye{0.0};
     glm::dvec3 forward{0.0, 0.0, -1.0};
@@ -34,9 +34,6 @@ struct CameraFrame {
     DQJ_API glm::dvec3 rayDirection(double px, double py) const;
 };
 
-/// The bounds the renderer uses: params.bounds if set, else containingBounds(). Throws
-/// ParamError if the slice misses the containment region and no bounds are set.
-DQJ_API Bounds renderBounds(const Params& params);
 DQJ_API CameraFrame frameCamera(const Params& params, const Bounds& bounds);
 
 struct RenderStats {
@@ -62,10 +59,5 @@ enum class RenderEngine {
 /// `progress` returned false.
 DQJ_API RenderResult render(const Params& params, const ProgressCallback& progress = {},
                             RenderEngine engine = RenderEngine::Packet);
-
-/// The material's colour (linear RGB) for a point with this escape result: `solid` gives
-/// material.color, `iterations` maps the smooth escape count and `trap` the orbit trap through
-/// the palette. The renderer shades with it; the bake colours mesh vertices and volumes with it.
-DQJ_API glm::dvec3 orbitColour(const Material& material, const Fractal& fractal, const Escape& escape);
 
 }  // namespace dqj

@@ -77,4 +77,12 @@ struct Bounds {
 /// that region entirely, so the slice is empty whatever N is.
 DQJ_API std::optional<Bounds> containingBounds(const Fractal& fractal, const Slice& slice);
 
+struct Params;  // params.hpp
+
+/// The bounds everything that draws or samples the set starts from (the renderer, the bakes,
+/// the POV-Ray scene, the add-on's preview): params.bounds if set, else containingBounds() of
+/// the effective slice. Throws ParamError (params.hpp) if the slice misses the containment
+/// region and no bounds are set.
+DQJ_API Bounds renderBounds(const Params& params);
+
 }  // namespace dqj
