@@ -193,13 +193,19 @@ int main(int argc, char** argv) {
     for (const Variant variant : kVariants) {
         benchmark::RegisterBenchmark(name("scalar", variant).c_str(), scalarReference, variant);
         for (const BatchTarget& target : {best, fallback}) {
-            benchmark::RegisterBenchmark(name("simd_double", variant, target.name).c_str(), simdBatch<double>, variant, target.id);
-            benchmark::RegisterBenchmark(name("simd_float", variant, target.name).c_str(), simdBatch<float>, variant, target.id);
+            benchmark::RegisterBenchmark(name("simd_double", variant, target.name).c_str(), simdBatch<double>, variant,
+                                         target.id);
+            benchmark::RegisterBenchmark(name("simd_float", variant, target.name).c_str(), simdBatch<float>, variant,
+                                         target.id);
         }
     }
     // Wall-clock time: the renderer runs on every core.
-    benchmark::RegisterBenchmark("render/packet", renderScene, RenderEngine::Packet)->UseRealTime()->Unit(benchmark::kMillisecond);
-    benchmark::RegisterBenchmark("render/scalar", renderScene, RenderEngine::Scalar)->UseRealTime()->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark("render/packet", renderScene, RenderEngine::Packet)
+        ->UseRealTime()
+        ->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark("render/scalar", renderScene, RenderEngine::Scalar)
+        ->UseRealTime()
+        ->Unit(benchmark::kMillisecond);
     benchmark::Initialize(&argc, argv);
     SummaryReporter reporter;
     benchmark::RunSpecifiedBenchmarks(&reporter);
@@ -214,16 +220,19 @@ int main(int argc, char** argv) {
     const double fmaFloatLanes = split && floatLanes > 8 ? floatLanes / 2 : floatLanes;
     const double peakDouble = fmaDoubleLanes * 2.0 * 2.0 * ghz * 1e9;
     const double peakFloat = fmaFloatLanes * 2.0 * 2.0 * ghz * 1e9;
-    std::printf("\nSummary (same run, one thread; %s dispatched, %s fallback)\n", best.name.c_str(), fallback.name.c_str());
-    std::printf("peak of one core: %.0f lanes (double) / %.0f (float) per FMA x 2 FMA units x 2 flops x %.3f GHz = "
-                "%.1f GFLOP/s double, %.1f float%s\n",
-                fmaDoubleLanes, fmaFloatLanes, ghz, peakDouble / 1e9, peakFloat / 1e9,
-                split ? " (512-bit FMAs counted as two 256-bit halves: AMD Zen 4)" : "");
+    std::printf("\nSummary (same run, one thread; %s dispatched, %s fallback)\n", best.name.c_str(),
+                fallback.name.c_str());
+    std::printf(
+        "peak of one core: %.0f lanes (double) / %.0f (float) per FMA x 2 FMA units x 2 flops x %.3f GHz = "
+        "%.1f GFLOP/s double, %.1f float%s\n",
+        fmaDoubleLanes, fmaFloatLanes, ghz, peakDouble / 1e9, peakFloat / 1e9,
+        split ? " (512-bit FMAs counted as two 256-bit halves: AMD Zen 4)" : "");
     if (split)
-        std::printf("(at the full detected width, %.0f doubles / %.0f floats, the nominal peak would be %.1f / %.1f GFLOP/s)\n",
-                    doubleLanes, floatLanes, doubleLanes * 4.0 * ghz, floatLanes * 4.0 * ghz);
-    std::printf("%-14s %14s %14s %8s %14s %8s %14s %9s %9s %9s\n", "variant", "scalar Meval/s", "double Meval/s", "x scalar",
-                "float Meval/s", "x scalar", "fallback dbl", "scal %pk", "dbl %pk", "flt %pk");
+        std::printf(
+            "(at the full detected width, %.0f doubles / %.0f floats, the nominal peak would be %.1f / %.1f GFLOP/s)\n",
+            doubleLanes, floatLanes, doubleLanes * 4.0 * ghz, floatLanes * 4.0 * ghz);
+    std::printf("%-14s %14s %14s %8s %14s %8s %14s %9s %9s %9s\n", "variant", "scalar Meval/s", "double Meval/s",
+                "x scalar", "float Meval/s", "x scalar", "fallback dbl", "scal %pk", "dbl %pk", "flt %pk");
     for (const Variant variant : kVariants) {
         auto rate = [&](const std::string& key) {
             const auto found = reporter.evaluations.find(key);
@@ -238,15 +247,17 @@ int main(int argc, char** argv) {
         const std::string doubleKey = name("simd_double", variant, best.name);
         const std::string floatKey = name("simd_float", variant, best.name);
         std::printf("%-14s %14.2f %14.2f %8.2f %14.2f %8.2f %14.2f %8.1f%% %8.1f%% %8.1f%%\n",
-                    std::string(variantName(variant)).c_str(), scalar / 1e6, rate(doubleKey) / 1e6, rate(doubleKey) / scalar,
-                    rate(floatKey) / 1e6, rate(floatKey) / scalar, rate(name("simd_double", variant, fallback.name)) / 1e6,
+                    std::string(variantName(variant)).c_str(), scalar / 1e6, rate(doubleKey) / 1e6,
+                    rate(doubleKey) / scalar, rate(floatKey) / 1e6, rate(floatKey) / scalar,
+                    rate(name("simd_double", variant, fallback.name)) / 1e6,
                     100.0 * flops(name("scalar", variant)) / peakDouble, 100.0 * flops(doubleKey) / peakDouble,
                     100.0 * flops(floatKey) / peakFloat);
     }
     const auto packet = reporter.evaluations.find("render/packet/real_time");
     const auto scalar = reporter.evaluations.find("render/scalar/real_time");
     if (packet != reporter.evaluations.end() && scalar != reporter.evaluations.end() && scalar->second > 0.0)
-        std::printf("renderer, 640x480 quaternion Julia (bench/compare.py's scene): packet %.1f ms, scalar %.1f ms, %.2fx\n",
-                    1e3 / packet->second, 1e3 / scalar->second, packet->second / scalar->second);
+        std::printf(
+            "renderer, 640x480 quaternion Julia (bench/compare.py's scene): packet %.1f ms, scalar %.1f ms, %.2fx\n",
+            1e3 / packet->second, 1e3 / scalar->second, packet->second / scalar->second);
     return 0;
 }

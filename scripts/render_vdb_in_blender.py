@@ -106,4 +106,4 @@ def main(args):
     print(f"render_vdb_in_blender: wrote {args.png}")
 
 
-main(parse(sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []))
+main(parse(sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else []))

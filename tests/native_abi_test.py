@@ -14,8 +14,14 @@ import re
 import subprocess
 import sys
 
-CTYPES = {"int32_t": ctypes.c_int32, "double": ctypes.c_double, "uint64_t": ctypes.c_uint64,
-          "float": ctypes.c_float, "uint32_t": ctypes.c_uint32, "size_t": ctypes.c_size_t}
+CTYPES = {
+    "int32_t": ctypes.c_int32,
+    "double": ctypes.c_double,
+    "uint64_t": ctypes.c_uint64,
+    "float": ctypes.c_float,
+    "uint32_t": ctypes.c_uint32,
+    "size_t": ctypes.c_size_t,
+}
 
 
 def main():

@@ -26,11 +26,16 @@ def main():
         checks["zip manifest version %s" % manifest["version"]] = manifest["version"] == version
         init = ast.parse(archive.read("dqjulia/__init__.py").decode())
         buildinfo = archive.read("dqjulia/_buildinfo.py").decode()
-    bl_info = next(ast.literal_eval(node.value) for node in init.body
-                   if isinstance(node, ast.Assign) and getattr(node.targets[0], "id", "") == "bl_info")
+    bl_info = next(
+        ast.literal_eval(node.value)
+        for node in init.body
+        if isinstance(node, ast.Assign) and getattr(node.targets[0], "id", "") == "bl_info"
+    )
     checks["zip bl_info version %s" % (bl_info["version"],)] = bl_info["version"] == (major, minor, patch)
-    checks["zip build info"] = ('PROJECT_VERSION = "%s"' % version in buildinfo
-                                and "DQJ_VERSION_NUMBER = %d" % (major * 10000 + minor * 100 + patch) in buildinfo)
+    checks["zip build info"] = (
+        'PROJECT_VERSION = "%s"' % version in buildinfo
+        and "DQJ_VERSION_NUMBER = %d" % (major * 10000 + minor * 100 + patch) in buildinfo
+    )
 
     with open(source + "/blender_addon/dqjulia/blender_manifest.toml", "rb") as handle:
         checks["source manifest literal"] = tomllib.load(handle)["version"] == version
@@ -52,7 +57,8 @@ def main():
     with open(source + "/CHANGELOG.md") as handle:
         changelog = handle.read()
     checks["CHANGELOG.md has a section for %s or Unreleased" % version] = (
-        re.search(r"^## (%s|Unreleased)\b" % re.escape(version), changelog, re.M) is not None)
+        re.search(r"^## (%s|Unreleased)\b" % re.escape(version), changelog, re.M) is not None
+    )
 
     for name, ok in checks.items():
         print("%s: %s" % ("ok" if ok else "FAIL", name))

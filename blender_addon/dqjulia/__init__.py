@@ -28,9 +28,12 @@ class DQJuliaPreferences(bpy.types.AddonPreferences):
     bl_idname = __package__
 
     cache_dir: StringProperty(
-        name="Cache folder", subtype="DIR_PATH", default="",
+        name="Cache folder",
+        subtype="DIR_PATH",
+        default="",
         description="Where volume bakes are written (VDB files). Empty: beside the .blend, in //dqjulia_cache/ "
-                    "(stored relative, so the project can move); an absolute folder is stored absolute")
+        "(stored relative, so the project can move); an absolute folder is stored absolute",
+    )
 
     def draw(self, context):
         layout = self.layout
@@ -38,22 +41,26 @@ class DQJuliaPreferences(bpy.types.AddonPreferences):
         try:
             layout.label(text="Bakes go to: %s" % bakes.cache_root(context))
         except ValueError as error:
-            layout.label(text="Bakes go to: %s (beside the .blend once it is saved)" % bakes.chosen_cache(context),
-                         icon="INFO" if not bpy.data.filepath else "ERROR")
+            layout.label(
+                text="Bakes go to: %s (beside the .blend once it is saved)" % bakes.chosen_cache(context),
+                icon="INFO" if not bpy.data.filepath else "ERROR",
+            )
             if bpy.data.filepath:
                 layout.label(text=str(error), icon="ERROR")
         error = native.load_error()
         if error is None:
-            layout.label(text="Library: dqjulia %s (%s)" % (native.version()[1], native.library_path()),
-                         icon="CHECKMARK")
+            layout.label(
+                text="Library: dqjulia %s (%s)" % (native.version()[1], native.library_path()), icon="CHECKMARK"
+            )
         else:
             box = layout.box()
             box.alert = True
             for line in panels.textwrap.wrap(error, 90):
                 box.label(text=line)
         if not osl.available():
-            layout.label(text="This Blender has no OSL: the OSL volume is unavailable (bakes and preview work).",
-                         icon="INFO")
+            layout.label(
+                text="This Blender has no OSL: the OSL volume is unavailable (bakes and preview work).", icon="INFO"
+            )
 
 
 def register():

@@ -32,6 +32,7 @@ def action_fcurves(obj, create=False):
     slot = getattr(animation_data, "action_slot", None)
     if hasattr(action, "layers") and slot is not None:
         from bpy_extras import anim_utils
+
         channelbag = anim_utils.action_get_channelbag_for_slot(action, slot)
         if channelbag is None and create and hasattr(anim_utils, "action_ensure_channelbag_for_slot"):
             channelbag = anim_utils.action_ensure_channelbag_for_slot(action, slot)
@@ -73,23 +74,29 @@ def animation_section(obj):
             offset = 0 if path.endswith("c_a") else 4
             constant_curves[offset + curve.array_index] = curve
         elif path in ("dqjulia.iterations", "dqjulia.bailout"):
-            key = "fractal." + path[len(PREFIX):]
+            key = "fractal." + path[len(PREFIX) :]
             keys = []
             for point in sorted(curve.keyframe_points, key=lambda p: p.co.x):
                 value = int(round(point.co.y)) if key == "fractal.iterations" else props._number(point.co.y)
-                keys.append({"frame": float(point.co.x), "value": value,
-                             "interpolation": _interpolation(curve, point.co.x)})
+                keys.append(
+                    {"frame": float(point.co.x), "value": value, "interpolation": _interpolation(curve, point.co.x)}
+                )
             if keys:
                 section[key] = keys
         elif _ROTATION.match(path):
             index = int(_ROTATION.match(path).group(1))
-            keys = [{"frame": float(point.co.x), "value": props._number(point.co.y),
-                     "interpolation": _interpolation(curve, point.co.x)}
-                    for point in sorted(curve.keyframe_points, key=lambda p: p.co.x)]
+            keys = [
+                {
+                    "frame": float(point.co.x),
+                    "value": props._number(point.co.y),
+                    "interpolation": _interpolation(curve, point.co.x),
+                }
+                for point in sorted(curve.keyframe_points, key=lambda p: p.co.x)
+            ]
             if keys:
                 section["slice.rotations[%d].degrees" % index] = keys
         else:
-            name = path[len(PREFIX):]
+            name = path[len(PREFIX) :]
             if name not in skipped:
                 skipped.append(name)
     if constant_curves:
@@ -97,10 +104,18 @@ def animation_section(obj):
         static = list(settings.c_a) + list(settings.c_b)
         keys = []
         for frame in frames:
-            value = [props._number(constant_curves[i].evaluate(frame)) if i in constant_curves else props._number(static[i])
-                     for i in range(8)]
-            interpolation = next((_interpolation(curve, frame) for curve in constant_curves.values()
-                                  if any(abs(p.co.x - frame) < 1e-6 for p in curve.keyframe_points)), "smooth")
+            value = [
+                props._number(constant_curves[i].evaluate(frame)) if i in constant_curves else props._number(static[i])
+                for i in range(8)
+            ]
+            interpolation = next(
+                (
+                    _interpolation(curve, frame)
+                    for curve in constant_curves.values()
+                    if any(abs(p.co.x - frame) < 1e-6 for p in curve.keyframe_points)
+                ),
+                "smooth",
+            )
             keys.append({"frame": float(frame), "value": value, "interpolation": interpolation})
         section["fractal.c"] = keys
     return section, skipped

@@ -25,9 +25,9 @@ import bpy
 from bpy.app.handlers import persistent
 
 ADDON_DIR = os.path.dirname(os.path.abspath(__file__))
-BAKE_KIND = "dqjulia_bake"      # custom property on baked objects: "volume", "mesh", "sequence"
-BAKE_FILES = "dqjulia_files"    # custom property: the files or folder the baked object reads (as stored)
-VOLUME_DENSITY_SCALE = 10.0     # the fog is 0..1; this makes the set read as solid-ish smoke
+BAKE_KIND = "dqjulia_bake"  # custom property on baked objects: "volume", "mesh", "sequence"
+BAKE_FILES = "dqjulia_files"  # custom property: the files or folder the baked object reads (as stored)
+VOLUME_DENSITY_SCALE = 10.0  # the fog is 0..1; this makes the set read as solid-ish smoke
 DEFAULT_CACHE = "//dqjulia_cache"  # beside the .blend
 
 # The bake files made since the .blend was last saved or opened (absolute, normalised): the
@@ -56,12 +56,16 @@ def cache_root(context=None):
     inside the add-on's folder (which Blender replaces on updates)."""
     chosen = chosen_cache(context)
     if chosen.startswith("//") and not bpy.data.filepath:
-        raise ValueError("save the .blend file first: volume bakes are stored beside it (in %s/), so they travel "
-                         "with the project (or choose an absolute cache folder in the add-on's preferences)" % chosen)
+        raise ValueError(
+            "save the .blend file first: volume bakes are stored beside it (in %s/), so they travel "
+            "with the project (or choose an absolute cache folder in the add-on's preferences)" % chosen
+        )
     root = os.path.abspath(bpy.path.abspath(chosen))
     if os.path.commonpath([root, ADDON_DIR]) == ADDON_DIR:
-        raise ValueError("the cache folder %s is inside the add-on's folder, which Blender replaces on updates; "
-                         "choose another in the add-on's preferences" % root)
+        raise ValueError(
+            "the cache folder %s is inside the add-on's folder, which Blender replaces on updates; "
+            "choose another in the add-on's preferences" % root
+        )
     return root
 
 
@@ -216,7 +220,7 @@ def build_volume(context, source, path, sequence=None):
     name = "%s %s" % (source.name, "Volume Sequence" if sequence else "Volume")
     names = grid_names(path)
     if "density" not in names:
-        raise RuntimeError("%s has no \"density\" grid (grids: %s)" % (path, ", ".join(names) or "none"))
+        raise RuntimeError('%s has no "density" grid (grids: %s)' % (path, ", ".join(names) or "none"))
     volume = bpy.data.volumes.new(name)
     material = None
     try:
@@ -275,7 +279,7 @@ def build_mesh(context, source, data):
         if hasattr(mesh, "use_auto_smooth"):  # Blender < 4.1: custom normals need auto smooth
             mesh.use_auto_smooth = True
         normals = data.normals
-        mesh.normals_split_custom_set_from_vertices([normals[i:i + 3] for i in range(0, len(normals), 3)])
+        mesh.normals_split_custom_set_from_vertices([normals[i : i + 3] for i in range(0, len(normals), 3)])
         if data.colors is not None and vertices:
             rgba = array.array("f", [1.0]) * (4 * vertices)
             for channel in range(3):
@@ -318,8 +322,14 @@ def renders_nothing(scene_objects, source):
 
 
 def unrendered_sources(scene):
-    return [obj for obj in scene.objects if getattr(obj, "dqjulia", None) is not None and obj.dqjulia.enabled
-            and not obj.hide_render and renders_nothing(scene.objects, obj)]
+    return [
+        obj
+        for obj in scene.objects
+        if getattr(obj, "dqjulia", None) is not None
+        and obj.dqjulia.enabled
+        and not obj.hide_render
+        and renders_nothing(scene.objects, obj)
+    ]
 
 
 @persistent
@@ -331,16 +341,26 @@ def _saved_or_opened(*_args):
 def _report_missing_at_render(scene, *_args):
     """Render log: a baked volume whose file is missing renders empty; say so."""
     for obj, path in missing_bakes(scene.objects):
-        print("dqjulia: WARNING: %s renders empty: its bake file %s (%s) is missing; bake it again, or find it "
-              "with File > External Data > Find Missing Files" % (obj.name, path, bpy.path.abspath(path)),
-              file=sys.stderr, flush=True)
+        print(
+            "dqjulia: WARNING: %s renders empty: its bake file %s (%s) is missing; bake it again, or find it "
+            "with File > External Data > Find Missing Files" % (obj.name, path, bpy.path.abspath(path)),
+            file=sys.stderr,
+            flush=True,
+        )
     for obj in unrendered_sources(scene):
-        print("dqjulia: WARNING: %s renders nothing: the DQ Julia object is drawn in the viewport only; bake a "
-              "volume or a mesh (DQ Julia > Bake), or add an OSL volume (Cycles with OSL)" % obj.name,
-              file=sys.stderr, flush=True)
+        print(
+            "dqjulia: WARNING: %s renders nothing: the DQ Julia object is drawn in the viewport only; bake a "
+            "volume or a mesh (DQ Julia > Bake), or add an OSL volume (Cycles with OSL)" % obj.name,
+            file=sys.stderr,
+            flush=True,
+        )
 
 
-_HANDLERS = (("save_post", _saved_or_opened), ("load_post", _saved_or_opened), ("render_init", _report_missing_at_render))
+_HANDLERS = (
+    ("save_post", _saved_or_opened),
+    ("load_post", _saved_or_opened),
+    ("render_init", _report_missing_at_render),
+)
 
 
 def register():

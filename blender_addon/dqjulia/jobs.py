@@ -16,7 +16,7 @@ import time
 
 from . import native
 
-_active = []          # running jobs, for the panels
+_active = []  # running jobs, for the panels
 _lock = threading.Lock()
 
 
@@ -24,10 +24,10 @@ class MeshData:
     """A mesh copied out of the core: flat arrays ready for foreach_set (no bpy)."""
 
     def __init__(self, positions, normals, colors, triangles):
-        self.positions = positions    # array('f'), 3 a vertex
-        self.normals = normals        # array('f'), 3 a vertex
-        self.colors = colors          # array('f'), 3 a vertex, or None
-        self.triangles = triangles    # array('i'), 3 a triangle
+        self.positions = positions  # array('f'), 3 a vertex
+        self.normals = normals  # array('f'), 3 a vertex
+        self.colors = colors  # array('f'), 3 a vertex, or None
+        self.triangles = triangles  # array('i'), 3 a triangle
 
     @property
     def vertex_count(self):
@@ -76,9 +76,12 @@ class MeshTask:
     def run(self, context, progress):
         self.warning = context.mesh_compute(progress)
         positions, normals, colors, triangles = context.mesh_copy(colors=self.colors)
-        return MeshData(_as_array("f", positions), _as_array("f", normals),
-                        _as_array("f", colors) if colors is not None else None,
-                        _as_array("i", triangles))
+        return MeshData(
+            _as_array("f", positions),
+            _as_array("f", normals),
+            _as_array("f", colors) if colors is not None else None,
+            _as_array("i", triangles),
+        )
 
 
 def format_duration(seconds):
@@ -105,13 +108,13 @@ class Job:
 
     def __init__(self, label, tasks, owner=""):
         self.label = label
-        self.owner = owner            # the object's name, for the panel
+        self.owner = owner  # the object's name, for the panel
         self.tasks = list(tasks)
         self.results = []
         self.state = Job.RUNNING
         self.error = ""
         self.warnings = []
-        self.index = 0                # the task under way
+        self.index = 0  # the task under way
         self._task_fraction = 0.0
         self._progress = None
         self._cancel = threading.Event()
@@ -131,12 +134,16 @@ class Job:
         self._task_fraction = fraction
 
     def status_text(self):
-        """"Bake sequence: 12 of 250 frames done, 4% (about 23 min left)"."""
+        """ "Bake sequence: 12 of 250 frames done, 4% (about 23 min left)"."""
         text = "%s: %d%%" % (self.label, round(100.0 * self.fraction))
         if len(self.tasks) > 1:
-            text = "%s: %d of %d %s done, %d%%" % (self.label, min(self.index, len(self.tasks)), len(self.tasks),
-                                                  "frames" if self.tasks[0].kind == "volume" else "parts",
-                                                  round(100.0 * self.fraction))
+            text = "%s: %d of %d %s done, %d%%" % (
+                self.label,
+                min(self.index, len(self.tasks)),
+                len(self.tasks),
+                "frames" if self.tasks[0].kind == "volume" else "parts",
+                round(100.0 * self.fraction),
+            )
         left = self.seconds_left()
         if left is not None:
             text += " (about %s left)" % format_duration(left)

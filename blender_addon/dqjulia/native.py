@@ -229,14 +229,16 @@ def _load():
     if not os.path.isfile(path):
         raise NativeUnavailable(
             "the dqjulia native library is missing: expected %s. The add-on zip must be the one the build "
-            "makes (build/dist/dqjulia_blender.zip), which holds the library; reinstall it" % path)
+            "makes (build/dist/dqjulia_blender.zip), which holds the library; reinstall it" % path
+        )
     try:
         library = ctypes.CDLL(path)
     except OSError as error:
         raise NativeUnavailable(
             "the dqjulia native library at %s could not be loaded (%s). It is self-contained and needs only "
             "Linux x86-64 with glibc 2.34 or newer (Debian 12, Ubuntu 22.04, RHEL 9 or later); on another "
-            "system, build the add-on there (README, Two commands)" % (path, error)) from error
+            "system, build the add-on there (README, Two commands)" % (path, error)
+        ) from error
     try:
         version_number = library.dqj_version_number
     except AttributeError:
@@ -248,7 +250,8 @@ def _load():
         raise NativeUnavailable(
             "the dqjulia library at %s is version %s, but this add-on needs %s (same major version, not "
             "older): install the add-on zip and the library from the same build"
-            % (path, version_text(found), version_text(EXPECTED_VERSION)))
+            % (path, version_text(found), version_text(EXPECTED_VERSION))
+        )
     return library, _bind(library)
 
 
@@ -463,10 +466,10 @@ class Context:
         for index, point in enumerate(points):
             if len(point) != width:
                 raise ValueError("each point needs %d numbers" % width)
-            flat[width * index:width * index + width] = [float(x) for x in point]
+            flat[width * index : width * index + width] = [float(x) for x in point]
         out = (Sample * max(1, len(points)))()
         self.check(getattr(self._lib, name)(self.handle, flat, len(points), out), name)
-        return list(out[:len(points)])
+        return list(out[: len(points)])
 
     # Rendering --------------------------------------------------------------------------
 
@@ -510,8 +513,9 @@ class Context:
 
     def mesh_sizes(self):
         vertices, triangles = ctypes.c_size_t(0), ctypes.c_size_t(0)
-        self.check(_function("dqj_mesh_get_sizes")(self.handle, ctypes.byref(vertices), ctypes.byref(triangles)),
-                   "mesh sizes")
+        self.check(
+            _function("dqj_mesh_get_sizes")(self.handle, ctypes.byref(vertices), ctypes.byref(triangles)), "mesh sizes"
+        )
         return vertices.value, triangles.value
 
     def mesh_copy(self, colors=True):
@@ -523,8 +527,9 @@ class Context:
         colours = (ctypes.c_float * (3 * vertex_count))() if colors else None
         triangles = (ctypes.c_uint32 * (3 * triangle_count))()
         function = _function("dqj_mesh_copy")
-        self.check(function(self.handle, positions, normals, colours, vertex_count, triangles, triangle_count),
-                   "mesh copy")
+        self.check(
+            function(self.handle, positions, normals, colours, vertex_count, triangles, triangle_count), "mesh copy"
+        )
         return positions, normals, colours, triangles
 
     def mesh_write(self, path):

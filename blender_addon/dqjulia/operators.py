@@ -45,8 +45,9 @@ def _preset_items(_self, _context):
     names = tuple(preset_names())
     if names != _PRESET_ITEMS["names"]:
         _PRESET_ITEMS["names"] = names
-        _PRESET_ITEMS["items"] = ([(name, name, "examples/%s.json" % name) for name in names]
-                                  or [("", "(no presets)", "")])
+        _PRESET_ITEMS["items"] = [(name, name, "examples/%s.json" % name) for name in names] or [
+            ("", "(no presets)", "")
+        ]
     return _PRESET_ITEMS["items"]
 
 
@@ -124,6 +125,7 @@ SLICE_TO_BLENDER_ROTATION = (math.pi / 2.0, 0.0, 0.0)
 
 class DQJULIA_OT_add(bpy.types.Operator):
     """Add a DQ Julia object: the set ray-marched in the viewport inside its bounds"""
+
     bl_idname = "object.dqjulia_add"
     bl_label = "DQ Julia"
     bl_options = {"REGISTER", "UNDO"}
@@ -164,6 +166,7 @@ class DQJULIA_OT_add(bpy.types.Operator):
 
 class DQJULIA_OT_load_preset(_NeedsDQJuliaObject, bpy.types.Operator):
     """Load one of the example parameter files into the active DQ Julia object"""
+
     bl_idname = "dqjulia.load_preset"
     bl_label = "Load Preset"
     bl_options = {"REGISTER", "UNDO"}
@@ -171,12 +174,14 @@ class DQJULIA_OT_load_preset(_NeedsDQJuliaObject, bpy.types.Operator):
     preset: EnumProperty(name="Preset", items=_preset_items)
 
     def execute(self, context):
-        return _read_params(self, context, os.path.join(PRESET_DIR, self.preset + ".json"),
-                            "Loaded preset %s" % self.preset)
+        return _read_params(
+            self, context, os.path.join(PRESET_DIR, self.preset + ".json"), "Loaded preset %s" % self.preset
+        )
 
 
 class DQJULIA_OT_import_params(_NeedsDQJuliaObject, bpy.types.Operator, ImportHelper):
     """Read a dqjulia parameter file (the JSON the command-line tool reads) into the active DQ Julia object"""
+
     bl_idname = "dqjulia.import_params"
     bl_label = "Import Parameters"
     bl_options = {"REGISTER", "UNDO"}
@@ -190,6 +195,7 @@ class DQJULIA_OT_import_params(_NeedsDQJuliaObject, bpy.types.Operator, ImportHe
 
 class DQJULIA_OT_export_params(_NeedsDQJuliaObject, bpy.types.Operator, ExportHelper):
     """Write the active DQ Julia object's parameters (and keyframes) as a dqjulia parameter file"""
+
     bl_idname = "dqjulia.export_params"
     bl_label = "Export Parameters"
 
@@ -206,8 +212,11 @@ class DQJULIA_OT_export_params(_NeedsDQJuliaObject, bpy.types.Operator, ExportHe
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         if skipped:
-            self.report({"WARNING"}, "Wrote %s; the file cannot hold the keyframes of %s (it animates the constant, "
-                        "iterations, bailout and rotation angles)" % (self.filepath, ", ".join(skipped)))
+            self.report(
+                {"WARNING"},
+                "Wrote %s; the file cannot hold the keyframes of %s (it animates the constant, "
+                "iterations, bailout and rotation angles)" % (self.filepath, ", ".join(skipped)),
+            )
         else:
             self.report({"INFO"}, "Wrote %s" % self.filepath)
         return {"FINISHED"}
@@ -215,12 +224,14 @@ class DQJULIA_OT_export_params(_NeedsDQJuliaObject, bpy.types.Operator, ExportHe
 
 class DQJULIA_OT_collection_edit(_NeedsDQJuliaObject, bpy.types.Operator):
     """Add or remove an entry of a list (rotations, lights, palette)"""
+
     bl_idname = "dqjulia.collection_edit"
     bl_label = "Edit List"
     bl_options = {"REGISTER", "UNDO", "INTERNAL"}
 
-    collection: EnumProperty(items=[("rotations", "Rotations", ""), ("lights", "Lights", ""),
-                                    ("palette", "Palette", "")])
+    collection: EnumProperty(
+        items=[("rotations", "Rotations", ""), ("lights", "Lights", ""), ("palette", "Palette", "")]
+    )
     action: EnumProperty(items=[("ADD", "Add", ""), ("REMOVE", "Remove", "")])
     index: bpy.props.IntProperty(default=-1)
 
@@ -250,8 +261,12 @@ class _BakeOperator:
 
     bl_options = {"REGISTER", "UNDO"}
 
-    synchronous: BoolProperty(name="Synchronous", default=False, options={"SKIP_SAVE", "HIDDEN"},
-                              description="Bake in the calling thread and return when done (scripts, tests)")
+    synchronous: BoolProperty(
+        name="Synchronous",
+        default=False,
+        options={"SKIP_SAVE", "HIDDEN"},
+        description="Bake in the calling thread and return when done (scripts, tests)",
+    )
 
     _job = None
     _timer = None
@@ -278,8 +293,11 @@ class _BakeOperator:
         if not _library_ready(self):
             return {"CANCELLED"}
         if not native.has("dqj_bake_vdb"):
-            self.report({"ERROR"}, "the dqjulia library %s cannot bake (no dqj_bake_vdb): install the add-on zip "
-                                   "from a build with OpenVDB baking" % native.version()[1])
+            self.report(
+                {"ERROR"},
+                "the dqjulia library %s cannot bake (no dqj_bake_vdb): install the add-on zip "
+                "from a build with OpenVDB baking" % native.version()[1],
+            )
             return {"CANCELLED"}
         obj = dqjulia_object(context)
         try:
@@ -389,6 +407,7 @@ def _bake_document(obj, need_density=False):
 
 class DQJULIA_OT_bake_volume(_BakeOperator, bpy.types.Operator):
     """Bake the set at this frame to an OpenVDB file and add a Volume object that renders it"""
+
     bl_idname = "dqjulia.bake_volume"
     bl_label = "Bake Volume"
 
@@ -407,6 +426,7 @@ class DQJULIA_OT_bake_volume(_BakeOperator, bpy.types.Operator):
 
 class DQJULIA_OT_bake_mesh(_BakeOperator, bpy.types.Operator):
     """Mesh the set's surface at this frame and add it as a mesh object with normals and colours"""
+
     bl_idname = "dqjulia.bake_mesh"
     bl_label = "Bake Mesh"
 
@@ -419,8 +439,9 @@ class DQJULIA_OT_bake_mesh(_BakeOperator, bpy.types.Operator):
     def build(self, context, obj, job):
         data = job.results[0]
         if data.triangle_count == 0:
-            raise RuntimeError("the surface has no triangles at this resolution%s"
-                               % ("; " + job.warnings[0] if job.warnings else ""))
+            raise RuntimeError(
+                "the surface has no triangles at this resolution%s" % ("; " + job.warnings[0] if job.warnings else "")
+            )
         mesh = bakes.build_mesh(context, obj, data)
         return "Baked %s: %d vertices, %d triangles" % (mesh.name, data.vertex_count, data.triangle_count)
 
@@ -453,13 +474,14 @@ def estimate_sequence(document, frames, folder):
 
     def extrapolate(low, high):
         power = max(2.0, min(3.0, math.log(max(high, 1e-9) / max(low, 1e-9)) / math.log(r2 / r1)))
-        return high * scale ** power
+        return high * scale**power
 
     return extrapolate(s1, s2) * len(frames), extrapolate(t1, t2) * len(frames)
 
 
 class DQJULIA_OT_bake_sequence(_BakeOperator, bpy.types.Operator):
     """Bake a volume for every frame of the scene's frame range (the keyframed values of each frame) and add a Volume object that plays them back"""
+
     bl_idname = "dqjulia.bake_sequence"
     bl_label = "Bake Sequence"
 
@@ -479,8 +501,13 @@ class DQJULIA_OT_bake_sequence(_BakeOperator, bpy.types.Operator):
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         self._estimate = "%d frames (%d-%d) at %d voxels: about %s on disk and %s" % (
-            len(frames), frames[0], frames[-1], obj.dqjulia.bake_resolution, jobs.format_bytes(size),
-            jobs.format_duration(seconds))
+            len(frames),
+            frames[0],
+            frames[-1],
+            obj.dqjulia.bake_resolution,
+            jobs.format_bytes(size),
+            jobs.format_duration(seconds),
+        )
         return context.window_manager.invoke_props_dialog(self, width=420)
 
     def draw(self, _context):
@@ -506,8 +533,10 @@ class DQJULIA_OT_bake_sequence(_BakeOperator, bpy.types.Operator):
         self._cleanup = (directory,)
         self._frames = frames
         self._directory = directory
-        tasks = [jobs.VolumeTask(document, bakes.sequence_frame_path(directory, obj, frame), frame=frame)
-                 for frame, document in zip(frames, documents)]
+        tasks = [
+            jobs.VolumeTask(document, bakes.sequence_frame_path(directory, obj, frame), frame=frame)
+            for frame, document in zip(frames, documents)
+        ]
         return jobs.Job("Bake sequence", tasks, owner=obj.name)
 
     def build(self, context, obj, job):
@@ -518,6 +547,7 @@ class DQJULIA_OT_bake_sequence(_BakeOperator, bpy.types.Operator):
 
 class DQJULIA_OT_cancel_bakes(bpy.types.Operator):
     """Cancel the running bakes (same as Esc)"""
+
     bl_idname = "dqjulia.cancel_bakes"
     bl_label = "Cancel Bakes"
 
@@ -528,6 +558,7 @@ class DQJULIA_OT_cancel_bakes(bpy.types.Operator):
 
 class DQJULIA_OT_add_osl_volume(_NeedsDQJuliaObject, bpy.types.Operator):
     """Add a cube over the bounds with a Cycles OSL volume material that computes the set while rendering (needs a Blender built with OSL)"""
+
     bl_idname = "dqjulia.add_osl_volume"
     bl_label = "Add OSL Volume"
     bl_options = {"REGISTER", "UNDO"}
@@ -547,6 +578,7 @@ class DQJULIA_OT_add_osl_volume(_NeedsDQJuliaObject, bpy.types.Operator):
 
 class DQJULIA_OT_open_osl_text(bpy.types.Operator):
     """Load the OSL shader source into a text block (to read, or to use on a Blender with OSL)"""
+
     bl_idname = "dqjulia.open_osl_text"
     bl_label = "OSL Script to Text"
 
@@ -556,9 +588,19 @@ class DQJULIA_OT_open_osl_text(bpy.types.Operator):
         return {"FINISHED"}
 
 
-CLASSES = (DQJULIA_OT_add, DQJULIA_OT_load_preset, DQJULIA_OT_import_params, DQJULIA_OT_export_params,
-           DQJULIA_OT_collection_edit, DQJULIA_OT_bake_volume, DQJULIA_OT_bake_mesh, DQJULIA_OT_bake_sequence,
-           DQJULIA_OT_cancel_bakes, DQJULIA_OT_add_osl_volume, DQJULIA_OT_open_osl_text)
+CLASSES = (
+    DQJULIA_OT_add,
+    DQJULIA_OT_load_preset,
+    DQJULIA_OT_import_params,
+    DQJULIA_OT_export_params,
+    DQJULIA_OT_collection_edit,
+    DQJULIA_OT_bake_volume,
+    DQJULIA_OT_bake_mesh,
+    DQJULIA_OT_bake_sequence,
+    DQJULIA_OT_cancel_bakes,
+    DQJULIA_OT_add_osl_volume,
+    DQJULIA_OT_open_osl_text,
+)
 
 
 def menu_add(self, _context):

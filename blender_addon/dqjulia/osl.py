@@ -16,10 +16,12 @@ SCRIPT_PATH = os.path.join(os.path.dirname(os.path.abspath(__file__)), "shaders"
 TEXT_NAME = "dqjulia_density.osl"
 SOURCE_KEY = "dqjulia_osl_source"  # bakes.OSL_SOURCE
 
-UNAVAILABLE_MESSAGE = ("This Blender was built without Open Shading Language (bpy.app.build_options.cycles_osl "
-                       "is False; Debian's Blender is), so Cycles cannot run the DQ Julia OSL script. Use Bake "
-                       "Volume or Bake Mesh, or a Blender from blender.org; 'OSL Script to Text' still loads "
-                       "the script to read or copy.")
+UNAVAILABLE_MESSAGE = (
+    "This Blender was built without Open Shading Language (bpy.app.build_options.cycles_osl "
+    "is False; Debian's Blender is), so Cycles cannot run the DQ Julia OSL script. Use Bake "
+    "Volume or Bake Mesh, or a Blender from blender.org; 'OSL Script to Text' still loads "
+    "the script to read or copy."
+)
 
 
 def available():
@@ -48,11 +50,20 @@ def input_values(obj):
     c = fractal["c"]
     origin, axes = state.origin, state.axes
     values = {
-        "CaS": c[0], "CaV": c[1:4], "CbS": c[4], "CbV": c[5:8],
+        "CaS": c[0],
+        "CaV": c[1:4],
+        "CbS": c[4],
+        "CbV": c[5:8],
         "Variant": ["paper", "paper-coupled", "dual"].index(fractal["variant"]),
-        "Iterations": int(fractal["iterations"]), "Bailout": float(fractal["bailout"]),
-        "OriginAS": origin[0], "OriginAV": origin[1:4], "OriginBS": origin[4], "OriginBV": origin[5:8],
-        "Stretch": state.stretch, "BoundsCenter": state.bounds[0], "BoundsRadius": state.bounds[1],
+        "Iterations": int(fractal["iterations"]),
+        "Bailout": float(fractal["bailout"]),
+        "OriginAS": origin[0],
+        "OriginAV": origin[1:4],
+        "OriginBS": origin[4],
+        "OriginBV": origin[5:8],
+        "Stretch": state.stretch,
+        "BoundsCenter": state.bounds[0],
+        "BoundsRadius": state.bounds[1],
     }
     for name, axis in zip("XYZ", axes):
         values[name + "AS"] = axis[0]
@@ -98,8 +109,12 @@ def add_volume(context, source):
     values = input_values(source)
     center, radius = values["BoundsCenter"], values["BoundsRadius"]
     mesh = bpy.data.meshes.new("%s OSL Volume" % source.name)
-    corners = [(center[0] + sx * radius, center[1] + sy * radius, center[2] + sz * radius)
-               for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]
+    corners = [
+        (center[0] + sx * radius, center[1] + sy * radius, center[2] + sz * radius)
+        for sx in (-1, 1)
+        for sy in (-1, 1)
+        for sz in (-1, 1)
+    ]
     faces = [(0, 1, 3, 2), (4, 6, 7, 5), (0, 4, 5, 1), (2, 3, 7, 6), (0, 2, 6, 4), (1, 5, 7, 3)]
     mesh.from_pydata(corners, [], faces)  # 8 corners: the mesh bakes use foreach_set
     mesh.update()

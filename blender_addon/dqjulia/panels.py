@@ -118,10 +118,13 @@ class _MainPanel:
                 report = state.inspect[part]
                 re_, im = report["complex"]
                 inside = report["in_mandelbrot"]
-                column.label(text="%s ~ %.4g %+.4gi" % ("a" if part == "real" else "b", re_, im),
-                             icon="CHECKMARK" if inside else "ERROR")
-                column.label(text="in the Mandelbrot set" if inside else "outside the Mandelbrot set: dust",
-                             icon="BLANK1")
+                column.label(
+                    text="%s ~ %.4g %+.4gi" % ("a" if part == "real" else "b", re_, im),
+                    icon="CHECKMARK" if inside else "ERROR",
+                )
+                column.label(
+                    text="in the Mandelbrot set" if inside else "outside the Mandelbrot set: dust", icon="BLANK1"
+                )
             column.label(text="Inside: %.1f%% of the bounds" % (100.0 * state.inspect["inside_fraction"]))
         if preview.shader_error():
             _wrapped(layout.box(), preview.shader_error(), icon="ERROR", alert=True)
@@ -174,8 +177,10 @@ class _BoundsPanel(_Base):
         state = preview.state_for(obj)
         if state.bounds:
             center, radius, clipped = state.bounds
-            layout.label(text="Sphere: centre (%.3g, %.3g, %.3g), radius %.4g%s" % (
-                center[0], center[1], center[2], radius, " (clips an extrusion)" if clipped else ""))
+            layout.label(
+                text="Sphere: centre (%.3g, %.3g, %.3g), radius %.4g%s"
+                % (center[0], center[1], center[2], radius, " (clips an extrusion)" if clipped else "")
+            )
 
 
 class _PreviewPanel(_Base):
@@ -217,16 +222,25 @@ class _BakePanel(_Base):
             layout.prop(s, "bake_bounds_min")
             layout.prop(s, "bake_bounds_max")
         if native.load_error() is None and not native.has("dqj_bake_vdb"):
-            _wrapped(layout, "This dqjulia library cannot bake (built without OpenVDB baking).", icon="ERROR",
-                     alert=True)
+            _wrapped(
+                layout, "This dqjulia library cannot bake (built without OpenVDB baking).", icon="ERROR", alert=True
+            )
         if bakes.renders_nothing(context.scene.objects, obj):
-            _wrapped(layout.box(), "Renders (F12) show nothing yet: the preview is for the viewport. Bake a volume "
-                                   "or a mesh here%s." % (", or add an OSL volume below" if osl.available() else
-                                                          " (this Blender has no OSL volume)"), icon="INFO")
+            _wrapped(
+                layout.box(),
+                "Renders (F12) show nothing yet: the preview is for the viewport. Bake a volume "
+                "or a mesh here%s."
+                % (", or add an OSL volume below" if osl.available() else " (this Blender has no OSL volume)"),
+                icon="INFO",
+            )
         for baked, path in bakes.missing_bakes(obj.children):
-            _wrapped(layout.box(), "%s renders empty: its bake file %s is missing. Bake again, or find it with "
-                                   "File > External Data > Find Missing Files." % (baked.name, path),
-                     icon="ERROR", alert=True)
+            _wrapped(
+                layout.box(),
+                "%s renders empty: its bake file %s is missing. Bake again, or find it with "
+                "File > External Data > Find Missing Files." % (baked.name, path),
+                icon="ERROR",
+                alert=True,
+            )
         try:
             bakes.cache_root(context)
         except ValueError as error:
@@ -235,8 +249,11 @@ class _BakePanel(_Base):
         column.operator(operators.DQJULIA_OT_bake_volume.bl_idname, icon="OUTLINER_OB_VOLUME")
         column.operator(operators.DQJULIA_OT_bake_mesh.bl_idname, icon="MESH_ICOSPHERE")
         scene = context.scene
-        column.operator(operators.DQJULIA_OT_bake_sequence.bl_idname, icon="RENDER_ANIMATION",
-                        text="Bake Sequence %d-%d" % (scene.frame_start, scene.frame_end))
+        column.operator(
+            operators.DQJULIA_OT_bake_sequence.bl_idname,
+            icon="RENDER_ANIMATION",
+            text="Bake Sequence %d-%d" % (scene.frame_start, scene.frame_end),
+        )
         for job in jobs.active_jobs(obj.name):
             row = layout.row()
             row.label(text=job.status_text(), icon="TIME")
@@ -262,6 +279,7 @@ class _ShadingPanel(_Base):
     """The material and lights the preview shades with (and the core's renderer). The settings
     only `dqjulia render` uses (camera, image size, samples, output: the schema's image_only
     keys) are not shown; they stay in the object and in the exported parameter file."""
+
     bl_label = "Shading"
     bl_options = {"DEFAULT_CLOSED"}
 
@@ -279,8 +297,15 @@ class _ShadingPanel(_Base):
         remove.collection, remove.action = "palette", "REMOVE"
         for entry in s.palette:
             column.prop(entry, "color", text="")
-        props.draw_fields(column, s, [key for key in props.section_keys(
-            "material", exclude=("material.color", "material.coloring")) if not props.FIELDS[key].get("image_only")])
+        props.draw_fields(
+            column,
+            s,
+            [
+                key
+                for key in props.section_keys("material", exclude=("material.color", "material.coloring"))
+                if not props.FIELDS[key].get("image_only")
+            ],
+        )
         row = column.row()
         row.label(text="Lights")
         add = row.operator(operators.DQJULIA_OT_collection_edit.bl_idname, text="", icon="ADD")

@@ -27,18 +27,20 @@ SHADER_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "shaders")
 _shader = None
 _shader_error = None
 _handler = None
-_states = {}          # document JSON -> State
+_states = {}  # document JSON -> State
 _MAX_STATES = 64
-_context = None       # the main thread's native context for validation and inspection
-draw_count = 0        # previews drawn by the draw handler (tests read it)
+_context = None  # the main thread's native context for validation and inspection
+draw_count = 0  # previews drawn by the draw handler (tests read it)
 
 
 def shader_sources(program="preview"):
     """(interface declarations, vertex source, fragment source) of shaders/<program>.*,
     assembled as glsl_standalone.cmake assembles them for glslangValidator."""
+
     def read(name):
         with open(os.path.join(SHADER_DIR, name)) as file:
             return file.read()
+
     interface = []
     fragment_prefix = ""
     for line in read(program + ".interface").splitlines():
@@ -57,6 +59,7 @@ def shader_sources(program="preview"):
 
 def _create_shader(program, depth_write):
     import gpu
+
     interface, vertex, fragment = shader_sources(program)
     info = gpu.types.GPUShaderCreateInfo()
     stage = gpu.types.GPUStageInterfaceInfo("dqj_%s_iface" % program)
@@ -130,10 +133,10 @@ class State:
     def __init__(self, document, text):
         self.document = document
         self.text = text
-        self.error = None          # the core's validation message, or why the library is unusable
-        self.empty_reason = ""     # why nothing can be seen (slice proven empty, bounds missing)
+        self.error = None  # the core's validation message, or why the library is unusable
+        self.empty_reason = ""  # why nothing can be seen (slice proven empty, bounds missing)
         self.inspect = None
-        self.bounds = None         # (center, radius, clipped)
+        self.bounds = None  # (center, radius, clipped)
         self.origin = None
         self.axes = None
         self.stretch = 1.0
@@ -202,11 +205,18 @@ class PreviewParams(ctypes.Structure):
     """shaders/preview_params.glsl in std140: 16-byte members, matrices column by column."""
 
     _fields_ = [
-        ("slice_a", ctypes.c_float * 16), ("slice_b", ctypes.c_float * 16),
-        ("palette", ctypes.c_float * 16), ("lights", ctypes.c_float * 16),
-        ("ca", ctypes.c_float * 4), ("cb", ctypes.c_float * 4), ("bounds", ctypes.c_float * 4),
-        ("marching", ctypes.c_float * 4), ("color", ctypes.c_float * 4), ("phong", ctypes.c_float * 4),
-        ("ints", ctypes.c_int32 * 4), ("floats", ctypes.c_float * 4),
+        ("slice_a", ctypes.c_float * 16),
+        ("slice_b", ctypes.c_float * 16),
+        ("palette", ctypes.c_float * 16),
+        ("lights", ctypes.c_float * 16),
+        ("ca", ctypes.c_float * 4),
+        ("cb", ctypes.c_float * 4),
+        ("bounds", ctypes.c_float * 4),
+        ("marching", ctypes.c_float * 4),
+        ("color", ctypes.c_float * 4),
+        ("phong", ctypes.c_float * 4),
+        ("ints", ctypes.c_int32 * 4),
+        ("floats", ctypes.c_float * 4),
     ]
 
 
@@ -217,23 +227,43 @@ def _columns(columns):
         flat += [float(x) for x in column]
     return (ctypes.c_float * 16)(*flat)
 
+
 _CUBE_TRIANGLES = (
     # outward-facing, counter-clockwise seen from outside
-    (0, 2, 1), (0, 3, 2), (4, 5, 6), (4, 6, 7), (0, 1, 5), (0, 5, 4),
-    (2, 3, 7), (2, 7, 6), (1, 2, 6), (1, 6, 5), (0, 4, 7), (0, 7, 3),
+    (0, 2, 1),
+    (0, 3, 2),
+    (4, 5, 6),
+    (4, 6, 7),
+    (0, 1, 5),
+    (0, 5, 4),
+    (2, 3, 7),
+    (2, 7, 6),
+    (1, 2, 6),
+    (1, 6, 5),
+    (0, 4, 7),
+    (0, 7, 3),
 )
 
 
 def _cube(center, radius):
     r = radius * 1.0001
     cx, cy, cz = center
-    return [(cx - r, cy - r, cz - r), (cx + r, cy - r, cz - r), (cx + r, cy + r, cz - r), (cx - r, cy + r, cz - r),
-            (cx - r, cy - r, cz + r), (cx + r, cy - r, cz + r), (cx + r, cy + r, cz + r), (cx - r, cy + r, cz + r)]
+    return [
+        (cx - r, cy - r, cz - r),
+        (cx + r, cy - r, cz - r),
+        (cx + r, cy + r, cz - r),
+        (cx - r, cy + r, cz - r),
+        (cx - r, cy - r, cz + r),
+        (cx + r, cy - r, cz + r),
+        (cx + r, cy + r, cz + r),
+        (cx - r, cy + r, cz + r),
+    ]
 
 
 def uniforms(obj, state, view_matrix, projection_matrix, viewport_height):
     """(push constants {name: value}, PreviewParams, mirrored) for drawing `obj` with this view."""
     from mathutils import Vector
+
     s = obj.dqjulia
     document = state.document
     model_view = view_matrix @ obj.matrix_world
@@ -246,7 +276,7 @@ def uniforms(obj, state, view_matrix, projection_matrix, viewport_height):
         eye4 = (eye.x, eye.y, eye.z, 1.0)
         footprint = (pixel, 0.0)
     else:
-        direction = (inverse.to_3x3() @ Vector((0.0, 0.0, -1.0)))
+        direction = inverse.to_3x3() @ Vector((0.0, 0.0, -1.0))
         scale = max(1e-12, direction.length)
         direction = direction / scale
         eye4 = (direction.x, direction.y, direction.z, 0.0)
@@ -279,15 +309,25 @@ def uniforms(obj, state, view_matrix, projection_matrix, viewport_height):
     center, radius, clipped = state.bounds
     params.bounds = (ctypes.c_float * 4)(center[0], center[1], center[2], radius)
     max_steps = min(int(render["max_steps"]), int(s.preview_max_steps))
-    params.marching = (ctypes.c_float * 4)(float(render["step_factor"]), float(render["max_step"]), float(max_steps),
-                                           float(render["detail"]) * float(s.preview_detail))
+    params.marching = (ctypes.c_float * 4)(
+        float(render["step_factor"]),
+        float(render["max_step"]),
+        float(max_steps),
+        float(render["detail"]) * float(s.preview_detail),
+    )
     params.color = (ctypes.c_float * 4)(*(list(material["color"]) + [1.0]))
-    params.phong = (ctypes.c_float * 4)(material["ambient"], material["diffuse"], material["specular"],
-                                        material["shininess"])
-    params.ints = (ctypes.c_int32 * 4)(native.VARIANTS.index(fractal["variant"]), int(fractal["iterations"]),
-                                       ["solid", "iterations", "trap"].index(material["coloring"]), palette_size)
-    params.floats = (ctypes.c_float * 4)(float(fractal["bailout"]), float(state.stretch),
-                                         state.containment_radius, 1.0 if clipped else 0.0)
+    params.phong = (ctypes.c_float * 4)(
+        material["ambient"], material["diffuse"], material["specular"], material["shininess"]
+    )
+    params.ints = (ctypes.c_int32 * 4)(
+        native.VARIANTS.index(fractal["variant"]),
+        int(fractal["iterations"]),
+        ["solid", "iterations", "trap"].index(material["coloring"]),
+        palette_size,
+    )
+    params.floats = (ctypes.c_float * 4)(
+        float(fractal["bailout"]), float(state.stretch), state.containment_radius, 1.0 if clipped else 0.0
+    )
     push = {"dqj_mvp": mvp, "dqj_eye": eye4, "dqj_footprint": footprint}
     return push, params, model_view.determinant() < 0.0
 
@@ -297,6 +337,7 @@ def draw_object(obj, view_matrix, projection_matrix, viewport_height):
     Returns False (and draws nothing) if the object's parameters are not drawable."""
     import gpu
     from gpu_extras.batch import batch_for_shader
+
     state = state_for(obj)
     if not state.drawable:
         return False
@@ -339,6 +380,7 @@ def _bounds_outline(center, radius, segments=64):
 
 def _uniform_color_shader():
     import gpu
+
     for name in ("UNIFORM_COLOR", "3D_UNIFORM_COLOR"):
         try:
             return gpu.shader.from_builtin(name)
@@ -351,6 +393,7 @@ def draw_outline(obj, colour):
     """The bounding sphere as three circles, in the object's frame (uses gpu.matrix)."""
     import gpu
     from gpu_extras.batch import batch_for_shader
+
     state = state_for(obj)
     if state.bounds is None:
         return
@@ -399,6 +442,7 @@ class _ViewCache:
 
     def ensure(self, width, height):
         import gpu
+
         if self.size != (width, height):
             self.color = gpu.types.GPUTexture((width, height), format="RGBA16F")
             self.depth = gpu.types.GPUTexture((width, height), format="DEPTH_COMPONENT32F")
@@ -407,8 +451,8 @@ class _ViewCache:
             self.key = None
 
 
-_view_caches = {}     # region pointer -> _ViewCache
-render_count = 0      # previews ray-marched into a cache (tests read it)
+_view_caches = {}  # region pointer -> _ViewCache
+render_count = 0  # previews ray-marched into a cache (tests read it)
 
 
 def _matrix_key(matrix):
@@ -420,6 +464,7 @@ def draw_cached(region_key, objects, view, projection, width, height):
     global render_count
     import gpu
     from gpu_extras.batch import batch_for_shader
+
     scale = max(1, max(obj.dqjulia.preview_resolution for obj in objects))
     cache_width, cache_height = max(1, width // scale), max(1, height // scale)
     # What the pixels depend on: the size and, per object, the exact shader inputs (so a change
@@ -427,8 +472,9 @@ def draw_cached(region_key, objects, view, projection, width, height):
     key = [cache_width, cache_height]
     for obj in objects:
         push, params, mirrored = uniforms(obj, state_for(obj), view, projection, cache_height)
-        key += [bytes(params), mirrored] + [_matrix_key(value) if hasattr(value, "row") else tuple(value)
-                                            for value in push.values()]
+        key += [bytes(params), mirrored] + [
+            _matrix_key(value) if hasattr(value, "row") else tuple(value) for value in push.values()
+        ]
     key = tuple(key)
     cache = _view_caches.get(region_key)
     if cache is None:
@@ -463,6 +509,7 @@ def draw_cached(region_key, objects, view, projection, width, height):
 def _draw_handler():
     global draw_count
     import gpu
+
     context = bpy.context
     if native.load_error() is not None or _shader_error is not None:
         return

@@ -17,8 +17,16 @@ import os
 import struct
 
 import bpy
-from bpy.props import (BoolProperty, CollectionProperty, EnumProperty, FloatProperty, FloatVectorProperty,
-                       IntProperty, PointerProperty, StringProperty)
+from bpy.props import (
+    BoolProperty,
+    CollectionProperty,
+    EnumProperty,
+    FloatProperty,
+    FloatVectorProperty,
+    IntProperty,
+    PointerProperty,
+    StringProperty,
+)
 
 from .slicing import AXIS_NAMES
 
@@ -62,8 +70,9 @@ def choice_items(key):
 VARIANT_ITEMS = choice_items("fractal.variant")
 COLORING_ITEMS = choice_items("material.coloring")
 GRID_ITEMS = choice_items("bake.grids")
-AXIS_ITEMS = [(name, name, "%s part, %s component" % ("real" if name[0] == "a" else "dual", name[2]))
-              for name in AXIS_NAMES]
+AXIS_ITEMS = [
+    (name, name, "%s part, %s component" % ("real" if name[0] == "a" else "dual", name[2])) for name in AXIS_NAMES
+]
 AXES_MODE_ITEMS = [
     ("NAMES", "Axis names", "Each of x, y, z runs along one 8-D coordinate axis"),
     ("VECTORS", "Vectors", "Each of x, y, z runs along an 8-D vector"),
@@ -126,8 +135,16 @@ def make_property(key, **overrides):
     if kind in ("vec3", "color", "vec8"):
         size = 8 if kind == "vec8" else 3
         subtype = "COLOR" if kind == "color" else "NONE"
-        return FloatVectorProperty(size=size, default=tuple(value), subtype=subtype, precision=5, step=1,
-                                   **_limits(field), **options, **overrides)
+        return FloatVectorProperty(
+            size=size,
+            default=tuple(value),
+            subtype=subtype,
+            precision=5,
+            step=1,
+            **_limits(field),
+            **options,
+            **overrides,
+        )
     raise ValueError("no property for schema key %s (%s)" % (key, kind))
 
 
@@ -137,8 +154,15 @@ def _quaternion_halves(key):
     halves = {}
     for suffix, part, values in (("a", "real", field["default"][:4]), ("b", "dual", field["default"][4:])):
         halves["%s_%s" % (prop_name(key), suffix)] = FloatVectorProperty(
-            name="%s %s" % (field["label"], suffix), size=4, default=tuple(values), precision=5, step=1,
-            description="%s: %s part (s, i, j, k)" % (field["help"], part), update=_redraw, **_limits(field))
+            name="%s %s" % (field["label"], suffix),
+            size=4,
+            default=tuple(values),
+            precision=5,
+            step=1,
+            description="%s: %s part (s, i, j, k)" % (field["help"], part),
+            update=_redraw,
+            **_limits(field),
+        )
     return halves
 
 
@@ -146,8 +170,11 @@ def _annotations(prefix):
     """The properties of every value key under `prefix` ("lights[]." for a light's)."""
     annotations = {}
     for key, field in FIELDS.items():
-        if not key.startswith(prefix) or "[]" in key[len(prefix):] or field["type"] in ("object", "list",
-                                                                                          "color_list", "animation"):
+        if (
+            not key.startswith(prefix)
+            or "[]" in key[len(prefix) :]
+            or field["type"] in ("object", "list", "color_list", "animation")
+        ):
             continue
         if prefix == "" and "[]" in key:
             continue
@@ -159,16 +186,21 @@ def _annotations(prefix):
         else:
             annotations[prop_name(key)] = make_property(key)
             if field.get("optional") and kind != "choice":
-                annotations[use_name(key)] = BoolProperty(name=field["label"], default=False,
-                                                          description="Set: " + field["help"])
+                annotations[use_name(key)] = BoolProperty(
+                    name=field["label"], default=False, description="Set: " + field["help"]
+                )
     return annotations
 
 
 def _auto_toggles():
     """For each "auto" object ("bounds"), the toggle "<name>_auto" (on = "auto")."""
-    return {prop_name(key) + "_auto": BoolProperty(name="Automatic " + field["label"].lower(), default=True,
-                                                   update=_redraw, description=field["help"])
-            for key, field in FIELDS.items() if field.get("auto")}
+    return {
+        prop_name(key) + "_auto": BoolProperty(
+            name="Automatic " + field["label"].lower(), default=True, update=_redraw, description=field["help"]
+        )
+        for key, field in FIELDS.items()
+        if field.get("auto")
+    }
 
 
 def _group(name, doc, annotations):
@@ -176,20 +208,33 @@ def _group(name, doc, annotations):
 
 
 _first, _second = FIELDS["slice.rotations[].plane"]["default"].split(",")
-DQJRotation = _group("DQJRotation", "A rotation of the slice's axes in a plane of the 8-D space (slice.rotations[]).", {
-    "first": EnumProperty(name="From", items=AXIS_ITEMS, default=_first, update=_redraw,
-                          description=FIELDS["slice.rotations[].plane"]["help"]),
-    "second": EnumProperty(name="To", items=AXIS_ITEMS, default=_second, update=_redraw),
-    **_annotations("slice.rotations[]."),
-})
-DQJLight = _group("DQJLight", "A directional light of the core's renderer and the preview (lights[]).",
-                  _annotations("lights[]."))
+DQJRotation = _group(
+    "DQJRotation",
+    "A rotation of the slice's axes in a plane of the 8-D space (slice.rotations[]).",
+    {
+        "first": EnumProperty(
+            name="From",
+            items=AXIS_ITEMS,
+            default=_first,
+            update=_redraw,
+            description=FIELDS["slice.rotations[].plane"]["help"],
+        ),
+        "second": EnumProperty(name="To", items=AXIS_ITEMS, default=_second, update=_redraw),
+        **_annotations("slice.rotations[]."),
+    },
+)
+DQJLight = _group(
+    "DQJLight", "A directional light of the core's renderer and the preview (lights[]).", _annotations("lights[].")
+)
 DQJColor = _group("DQJColor", "A palette colour (material.palette[]).", {"color": make_property("material.palette[]")})
 
 _axes = FIELDS["slice.axes"]["default"].split(",")
 _settings = {
-    "enabled": BoolProperty(name="DQ Julia object", default=False,
-                            description="This object shows a dual-quaternion Julia set inside its bounds"),
+    "enabled": BoolProperty(
+        name="DQ Julia object",
+        default=False,
+        description="This object shows a dual-quaternion Julia set inside its bounds",
+    ),
     **_annotations(""),
     **_auto_toggles(),
     # slice.axes: names or vectors
@@ -199,16 +244,38 @@ _settings = {
     "lights": CollectionProperty(type=DQJLight, name=FIELDS["lights"]["label"]),
     "palette": CollectionProperty(type=DQJColor, name=FIELDS["material.palette"]["label"]),
     # the preview (not in the file)
-    "show_preview": BoolProperty(name="Preview", default=True, update=_redraw,
-                                 description="Ray-march the set in the viewport (GLSL)"),
-    "show_bounds": BoolProperty(name="Bounds", default=True, update=_redraw,
-                                description="Draw the bounding sphere as three circles"),
-    "preview_resolution": IntProperty(name="Preview pixel size", default=1, min=1, max=8, update=_redraw,
-                                      description="March one ray per N x N viewport pixels (faster on slow GPUs)"),
-    "preview_max_steps": IntProperty(name="Preview steps", default=160, min=8, max=100000, soft_max=1000,
-                                     update=_redraw, description="Most steps a preview ray takes (cost)"),
-    "preview_detail": FloatProperty(name="Preview detail", default=1.0, min=0.01, max=100.0, soft_max=8.0,
-                                    update=_redraw, description="Hit threshold in pixels for the preview"),
+    "show_preview": BoolProperty(
+        name="Preview", default=True, update=_redraw, description="Ray-march the set in the viewport (GLSL)"
+    ),
+    "show_bounds": BoolProperty(
+        name="Bounds", default=True, update=_redraw, description="Draw the bounding sphere as three circles"
+    ),
+    "preview_resolution": IntProperty(
+        name="Preview pixel size",
+        default=1,
+        min=1,
+        max=8,
+        update=_redraw,
+        description="March one ray per N x N viewport pixels (faster on slow GPUs)",
+    ),
+    "preview_max_steps": IntProperty(
+        name="Preview steps",
+        default=160,
+        min=8,
+        max=100000,
+        soft_max=1000,
+        update=_redraw,
+        description="Most steps a preview ray takes (cost)",
+    ),
+    "preview_detail": FloatProperty(
+        name="Preview detail",
+        default=1.0,
+        min=0.01,
+        max=100.0,
+        soft_max=8.0,
+        update=_redraw,
+        description="Hit threshold in pixels for the preview",
+    ),
     # sections of an imported file this version does not model, written back on export
     "extra_json": StringProperty(name="Other sections", default="{}", options={"HIDDEN"}),
 }
@@ -217,10 +284,20 @@ for _index, _axis in enumerate("xyz"):
     _unit = [0.0] * 8
     _unit[AXIS_NAMES.index(_axes[_index])] = 1.0
     _settings["axis_%s_vector" % _axis] = FloatVectorProperty(
-        name="%s axis" % _axis, size=8, default=tuple(_unit), precision=5, step=1, update=_redraw,
-        description="Where %s goes in 8-D" % _axis, **_limits(FIELDS["slice.axes"]))
-DQJuliaSettings = _group("DQJuliaSettings", "Everything the parameter file holds (README \"Parameter file\"), plus "
-                                            "the preview's options.", _settings)
+        name="%s axis" % _axis,
+        size=8,
+        default=tuple(_unit),
+        precision=5,
+        step=1,
+        update=_redraw,
+        description="Where %s goes in 8-D" % _axis,
+        **_limits(FIELDS["slice.axes"]),
+    )
+DQJuliaSettings = _group(
+    "DQJuliaSettings",
+    'Everything the parameter file holds (README "Parameter file"), plus the preview\'s options.',
+    _settings,
+)
 
 CLASSES = (DQJRotation, DQJLight, DQJColor, DQJuliaSettings)
 
@@ -287,8 +364,12 @@ def _get(document, key):
 def _value_keys(prefix=""):
     """The schema's value keys directly under `prefix`, in file order (not lists' items)."""
     for key, field in FIELDS.items():
-        if key.startswith(prefix) and "[]" not in key[len(prefix):] and (prefix or "[]" not in key) and \
-                field["type"] not in ("object", "list", "color_list", "animation"):
+        if (
+            key.startswith(prefix)
+            and "[]" not in key[len(prefix) :]
+            and (prefix or "[]" not in key)
+            and field["type"] not in ("object", "list", "color_list", "animation")
+        ):
             yield key, field
 
 
@@ -302,8 +383,11 @@ def _inside_auto(key):
 
 def _item(item, prefix):
     """A list item's document from its properties (a light, a rotation)."""
-    return {key[len(prefix):]: _json_value(field, getattr(item, prop_name(key))) for key, field in _value_keys(prefix)
-            if field["type"] != "axis_pair"}
+    return {
+        key[len(prefix) :]: _json_value(field, getattr(item, prop_name(key)))
+        for key, field in _value_keys(prefix)
+        if field["type"] != "axis_pair"
+    }
 
 
 def to_document(settings, values=None, with_animation=None):
@@ -366,7 +450,7 @@ def to_document(settings, values=None, with_animation=None):
 def _set_item(item, prefix, document):
     for key, field in _value_keys(prefix):
         if field["type"] != "axis_pair":
-            setattr(item, prop_name(key), document[key[len(prefix):]])
+            setattr(item, prop_name(key), document[key[len(prefix) :]])
 
 
 def from_document(settings, document):
@@ -436,8 +520,13 @@ def draw_fields(layout, settings, keys):
 
 def section_keys(section, exclude=()):
     """The scalar value keys of a section in file order (for draw_fields)."""
-    return [key for key, field in _value_keys(section + ".") if key not in exclude and not _inside_auto(key) and
-            field["type"] in ("boolean", "integer", "number", "string", "choice", "vec3", "color")]
+    return [
+        key
+        for key, field in _value_keys(section + ".")
+        if key not in exclude
+        and not _inside_auto(key)
+        and field["type"] in ("boolean", "integer", "number", "string", "choice", "vec3", "color")
+    ]
 
 
 def register():

@@ -57,8 +57,8 @@ int runBake(const BakeFlags& flags) {
             } catch (const Cancelled&) {
                 bar.finish();
                 if (index == 0) throw;
-                std::cerr << "dqjulia bake: interrupted at frame " << job.frame << "; frames " << jobs.front().frame << " to "
-                          << jobs[index - 1].frame << " were written, frame " << job.frame << " was not\n";
+                std::cerr << "dqjulia bake: interrupted at frame " << job.frame << "; frames " << jobs.front().frame
+                          << " to " << jobs[index - 1].frame << " were written, frame " << job.frame << " was not\n";
                 return kInterrupted;
             }
             bar.finish();
@@ -66,9 +66,10 @@ int runBake(const BakeFlags& flags) {
         if (stats.activeVoxels == 0) {
             const std::string reason = inspect(job.params).emptyReason;
             std::cerr << "dqjulia bake: warning: " << job.path << " holds no surface: "
-                      << (reason.empty() ? "nothing within the bounds is in the set at this resolution; try more iterations or a "
-                                           "higher resolution"
-                                         : reason)
+                      << (reason.empty()
+                              ? "nothing within the bounds is in the set at this resolution; try more iterations or a "
+                                "higher resolution"
+                              : reason)
                       << "\n";
         }
         if (!flags.quiet)
@@ -90,7 +91,8 @@ int runBake(const BakeFlags& flags) {
 Runner addBakeCommand(CLI::App& app) {
     auto flags = std::make_shared<BakeFlags>();
     CLI::App* command = app.add_subcommand(
-        "bake", "Bake an OpenVDB file: level set \"surface\", fog volume \"density\" and attribute grids (README: Baking)");
+        "bake",
+        "Bake an OpenVDB file: level set \"surface\", fog volume \"density\" and attribute grids (README: Baking)");
     flags->addTo(*command, false);
     return [flags] { return reportErrors("bake", [&] { return runBake(*flags); }); };
 }

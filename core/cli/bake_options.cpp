@@ -37,7 +37,8 @@ int parseFrame(const std::string& text, const std::string& whole) {
         used = 0;
     }
     if (text.empty() || used != text.size() || value < 0 || value > 999999 || text[0] == '+' || text[0] == '-')
-        throw ParamError("frames", "--frames \"" + whole + "\": expected FIRST-LAST with whole frame numbers from 0 to 999999, e.g. 1-48");
+        throw ParamError("frames", "--frames \"" + whole +
+                                       "\": expected FIRST-LAST with whole frame numbers from 0 to 999999, e.g. 1-48");
     return int(value);
 }
 
@@ -45,28 +46,41 @@ int parseFrame(const std::string& text, const std::string& whole) {
 
 void BakeFlags::addTo(CLI::App& command, bool mesh) {
     fractal.addTo(command);
-    command.add_option("-o,--output", output, mesh ? "Output mesh: .ply (binary) or .obj" : "Output OpenVDB file (.vdb)")
+    command
+        .add_option("-o,--output", output, mesh ? "Output mesh: .ply (binary) or .obj" : "Output OpenVDB file (.vdb)")
         ->required();
-    command.add_option("-r,--resolution", resolution, "Voxels across the largest side of the bounds (8..16384; default 256)")
+    command
+        .add_option("-r,--resolution", resolution,
+                    "Voxels across the largest side of the bounds (8..16384; default 256)")
         ->check(CLI::Range(8, 16384));
-    command.add_option("--bounds-min", boundsMin, "Bake only this box: its lowest corner x y z (with --bounds-max)")->expected(3);
-    command.add_option("--bounds-max", boundsMax, "Bake only this box: its highest corner x y z (with --bounds-min)")->expected(3);
+    command.add_option("--bounds-min", boundsMin, "Bake only this box: its lowest corner x y z (with --bounds-max)")
+        ->expected(3);
+    command.add_option("--bounds-max", boundsMax, "Bake only this box: its highest corner x y z (with --bounds-min)")
+        ->expected(3);
     if (mesh) {
-        command.add_option("--adaptivity", adaptivity, "0 = uniform quads; up to 1 merges flat regions into fewer polygons")
+        command
+            .add_option("--adaptivity", adaptivity,
+                        "0 = uniform quads; up to 1 merges flat regions into fewer polygons")
             ->check(CLI::Range(0.0, 1.0));
         command.add_flag("--no-colors", noColors, "No vertex colours");
     } else {
-        command.add_option("--grids", grids, "Grids to write, comma-separated: surface, density, color, trap, iterations "
-                                             "(default surface,density)");
-        command.add_option("--band-width", bandWidth, "Half width of the level set's narrow band in voxels (1..32; default 3)")
+        command.add_option("--grids", grids,
+                           "Grids to write, comma-separated: surface, density, color, trap, iterations "
+                           "(default surface,density)");
+        command
+            .add_option("--band-width", bandWidth,
+                        "Half width of the level set's narrow band in voxels (1..32; default 3)")
             ->check(CLI::Range(1.0, 32.0));
     }
-    command.add_option("--frames", frames, "Keyframed parameters: bake frames FIRST-LAST into NAME_0001.EXT, ... (or one frame)");
-    command.add_option("--max-memory", maxMemory, "Refuse when the estimate exceeds this, e.g. 4G or 512M (default: half the available memory)");
+    command.add_option("--frames", frames,
+                       "Keyframed parameters: bake frames FIRST-LAST into NAME_0001.EXT, ... (or one frame)");
+    command.add_option("--max-memory", maxMemory,
+                       "Refuse when the estimate exceeds this, e.g. 4G or 512M (default: half the available memory)");
     command.add_flag("--dense", dense, "Evaluate every voxel instead of skipping empty blocks (slow; for comparisons)");
     command.add_flag("-f,--force", force, "Overwrite existing output files");
     command.add_flag("-q,--quiet", quiet, "No progress bar or summary");
-    command.add_flag("--stats", stats, "Print time, voxels evaluated against dense, active voxels and peak memory to stdout");
+    command.add_flag("--stats", stats,
+                     "Print time, voxels evaluated against dense, active voxels and peak memory to stdout");
 }
 
 Params BakeFlags::load() const {
@@ -88,7 +102,8 @@ Params BakeFlags::load() const {
             const std::size_t comma = std::min(grids.find(',', start), grids.size());
             const std::string name = grids.substr(start, comma - start);
             bool known = false;
-            for (BakeGrid grid : {BakeGrid::Surface, BakeGrid::Density, BakeGrid::Color, BakeGrid::Trap, BakeGrid::Iterations}) {
+            for (BakeGrid grid :
+                 {BakeGrid::Surface, BakeGrid::Density, BakeGrid::Color, BakeGrid::Trap, BakeGrid::Iterations}) {
                 if (name != bakeGridName(grid)) continue;
                 known = true;
                 if (!hasGrid(bake, grid)) bake.grids.push_back(grid);
@@ -110,13 +125,15 @@ std::optional<FrameRange> BakeFlags::frameRange() const {
     range.first = parseFrame(frames.substr(0, dash), frames);
     range.last = dash == std::string::npos ? range.first : parseFrame(frames.substr(dash + 1), frames);
     if (range.last < range.first)
-        throw ParamError("frames", "--frames \"" + frames + "\": the last frame comes before the first; write FIRST-LAST, e.g. 1-48");
+        throw ParamError("frames", "--frames \"" + frames +
+                                       "\": the last frame comes before the first; write FIRST-LAST, e.g. 1-48");
     return range;
 }
 
 std::uint64_t BakeFlags::memoryLimit() const {
     if (maxMemory.empty()) return 0;
-    const std::string message = "--max-memory \"" + maxMemory + "\": expected a size such as 512M, 4G or 1.5G (or bytes)";
+    const std::string message =
+        "--max-memory \"" + maxMemory + "\": expected a size such as 512M, 4G or 1.5G (or bytes)";
     std::size_t used = 0;
     double value = 0.0;
     try {

@@ -98,8 +98,9 @@ void FractalOptions::applyTo(Params& params) const {
             }
         }
         if (!first || !second || *first == *second || !numberOk)
-            throw ParamError("slice.rotations", "--rotate \"" + text +
-                                                    "\": expected PLANE:DEGREES with two different axes, e.g. a.j,b.s:30");
+            throw ParamError("slice.rotations",
+                             "--rotate \"" + text +
+                                 "\": expected PLANE:DEGREES with two different axes, e.g. a.j,b.s:30");
         params.slice.rotations.push_back({*first, *second, degrees});
     }
 }
@@ -119,8 +120,9 @@ void checkOutputPath(const std::string& path, bool force, const std::string& fla
     if (fs::is_directory(target, error))
         throw ParamError("output.path", flag + " '" + path + "' is a folder; give a file name");
     if (fs::exists(target, error) && !fs::is_regular_file(target, error))
-        throw ParamError("output.path", flag + " '" + path + "' is not a regular file (a device, FIFO or socket); "
-                                        "dqjulia writes only regular files");
+        throw ParamError("output.path", flag + " '" + path +
+                                            "' is not a regular file (a device, FIFO or socket); "
+                                            "dqjulia writes only regular files");
     if (fs::exists(target, error) && !force)
         throw ParamError("output.path", flag + " '" + path + "' exists; pass --force to overwrite it");
     const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
@@ -198,12 +200,12 @@ bool ProgressBar::update(double fraction) {
     const int filled = int(fraction * kWidth);
     std::string bar(filled, '#');
     bar.resize(kWidth, '.');
-    std::string eta = fraction > 0.02 && fraction < 1.0 ? " ETA " + formatDuration(elapsed / fraction * (1.0 - fraction)) : "";
+    std::string eta =
+        fraction > 0.02 && fraction < 1.0 ? " ETA " + formatDuration(elapsed / fraction * (1.0 - fraction)) : "";
     char percent[16];
     std::snprintf(percent, sizeof percent, "%3d%%", int(fraction * 100.0));
     std::cerr << "\r" << label_ << " [" << bar << "] " << percent << "  " << formatDuration(elapsed) << eta
-              << (status_.empty() ? "" : "  ") << status_ << "\x1b[K"
-              << std::flush;
+              << (status_.empty() ? "" : "  ") << status_ << "\x1b[K" << std::flush;
     drawn_ = true;
     return true;
 }

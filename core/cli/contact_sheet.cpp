@@ -55,7 +55,8 @@ public:
                     const float coverage = bitmap.buffer[row * bitmap.pitch + column] / 255.0f;
                     float* pixel = &image.rgba[4 * (static_cast<std::size_t>(y) * image.width + px)];
                     for (int channel = 0; channel < 3; ++channel)
-                        pixel[channel] = pixel[channel] * (1.0f - coverage) + static_cast<float>(colour[channel]) * coverage;
+                        pixel[channel] =
+                            pixel[channel] * (1.0f - coverage) + static_cast<float>(colour[channel]) * coverage;
                 }
             }
             pen += static_cast<int>(glyph->advance.x >> 6);
@@ -100,10 +101,9 @@ std::vector<std::string> wrap(Font& font, const std::string& label, int maxWidth
 
 std::string labelFontPath() {
     if (const char* chosen = std::getenv("DQJ_FONT"); chosen && std::filesystem::exists(chosen)) return chosen;
-    for (const char* candidate : {"/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
-                                  "/usr/share/fonts/TTF/DejaVuSans.ttf",
-                                  "/usr/share/fonts/dejavu/DejaVuSans.ttf",
-                                  "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf"})
+    for (const char* candidate :
+         {"/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf", "/usr/share/fonts/TTF/DejaVuSans.ttf",
+          "/usr/share/fonts/dejavu/DejaVuSans.ttf", "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf"})
         if (std::filesystem::exists(candidate)) return candidate;
     return "";
 }
@@ -128,14 +128,16 @@ Image composeSheet(const std::vector<SheetTile>& tiles, const SheetLayout& layou
     const int lineHeight = layout.fontPixels + layout.fontPixels / 3;
     const int labelHeight = layout.labelLines * lineHeight + layout.padding / 2;
     std::vector<int> rowTops(rows, layout.padding);
-    for (int row = 1; row < rows; ++row) rowTops[row] = rowTops[row - 1] + rowHeights[row - 1] + labelHeight + layout.padding;
+    for (int row = 1; row < rows; ++row)
+        rowTops[row] = rowTops[row - 1] + rowHeights[row - 1] + labelHeight + layout.padding;
 
     Image sheet;
     sheet.width = layout.padding + columns * (cellWidth + layout.padding);
     sheet.height = rowTops.back() + rowHeights.back() + labelHeight + layout.padding;
     sheet.rgba.resize(4 * static_cast<std::size_t>(sheet.width) * sheet.height);
     for (std::size_t pixel = 0; pixel < sheet.rgba.size() / 4; ++pixel) {
-        for (int channel = 0; channel < 3; ++channel) sheet.rgba[4 * pixel + channel] = static_cast<float>(layout.background[channel]);
+        for (int channel = 0; channel < 3; ++channel)
+            sheet.rgba[4 * pixel + channel] = static_cast<float>(layout.background[channel]);
         sheet.rgba[4 * pixel + 3] = 1.0f;
     }
 

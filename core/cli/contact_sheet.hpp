@@ -23,10 +23,10 @@ struct SheetTile {
 
 struct SheetLayout {
     int columns = 3;
-    int padding = 8;                              ///< pixels around and between cells
-    int fontPixels = 13;                          ///< label text height
-    int labelLines = 3;                           ///< lines reserved under each tile
-    glm::dvec3 background{0.02, 0.02, 0.025};     ///< linear RGB
+    int padding = 8;                           ///< pixels around and between cells
+    int fontPixels = 13;                       ///< label text height
+    int labelLines = 3;                        ///< lines reserved under each tile
+    glm::dvec3 background{0.02, 0.02, 0.025};  ///< linear RGB
     glm::dvec3 text{0.85, 0.85, 0.85};
 };
 

@@ -49,7 +49,8 @@ int runEval(const EvalOptions& options) {
         if (!parseNumbers(line, numbers) || numbers.size() != expected) {
             std::fflush(stdout);
             throw ParamError("", "stdin line " + std::to_string(lineNumber) + ": expected " + std::to_string(expected) +
-                                     " numbers" + (options.sliceCoords ? " (x y z)" : " (a's s i j k, then b's s i j k)") +
+                                     " numbers" +
+                                     (options.sliceCoords ? " (x y z)" : " (a's s i j k, then b's s i j k)") +
                                      ", got \"" + line + "\"");
         }
         DualQuat point;
@@ -72,8 +73,9 @@ int runEval(const EvalOptions& options) {
 Runner addEvalCommand(CLI::App& app) {
     auto options = std::make_shared<EvalOptions>();
     CLI::App* command = app.add_subcommand(
-        "eval", "Evaluate points read from stdin (one per line: 8 numbers, or x y z with --slice-coords);\n"
-                "writes CSV n,r,ra,rb,de: escape iteration (0 = inside), escape norm, |a|, |b| at exit, distance estimate");
+        "eval",
+        "Evaluate points read from stdin (one per line: 8 numbers, or x y z with --slice-coords);\n"
+        "writes CSV n,r,ra,rb,de: escape iteration (0 = inside), escape norm, |a|, |b| at exit, distance estimate");
     options->fractal.addTo(*command);
     command->add_flag("--slice-coords", options->sliceCoords, "Read 3-D points and map them through the slice");
     return [options] { return reportErrors("eval", [&] { return runEval(*options); }); };

@@ -89,8 +89,8 @@ ExploreResult explore(const Params& base, const ExploreOptions& options) {
         }
         candidate.description = "dqjulia explore, seed " + std::to_string(options.seed) + ", tile " +
                                 std::to_string(result.tiles.size() + 1) + ": c = " + constantText(candidate.fractal.c) +
-                                ", variant " + std::string(variantName(candidate.fractal.variant)) + ", N = " +
-                                std::to_string(candidate.fractal.iterations);
+                                ", variant " + std::string(variantName(candidate.fractal.variant)) +
+                                ", N = " + std::to_string(candidate.fractal.iterations);
         result.tiles.push_back(std::move(candidate));
     }
     return result;

@@ -24,7 +24,7 @@ struct ExploreOptions {
 struct ExploreResult {
     std::vector<Params> tiles;  ///< `base` with a new constant each (description says where it came from)
     int attempts = 0;
-    int skippedEmpty = 0;       ///< candidates rejected because their slice was (nearly) empty
+    int skippedEmpty = 0;  ///< candidates rejected because their slice was (nearly) empty
 };
 
 /// Draws constants until `count` have non-empty slices (or maxAttempts is reached).

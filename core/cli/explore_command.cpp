@@ -67,9 +67,9 @@ int runExplore(const ExploreCommandOptions& options) {
     layout.columns = options.columns;
     writeImage(composeSheet(tiles, layout), sheetPath.string(), ImageFormat::Png8, existingPolicy(options.force));
     if (!options.quiet)
-        std::cerr << "wrote " << sheetPath.string() << " and " << tiles.size() << " tiles (tile_NN.png, tile_NN.json) to "
-                  << folder.string() << "; " << found.skippedEmpty << " of " << found.attempts
-                  << " candidate constants skipped for empty slices\n";
+        std::cerr << "wrote " << sheetPath.string() << " and " << tiles.size()
+                  << " tiles (tile_NN.png, tile_NN.json) to " << folder.string() << "; " << found.skippedEmpty << " of "
+                  << found.attempts << " candidate constants skipped for empty slices\n";
     return kSuccess;
 }
 
@@ -77,16 +77,18 @@ int runExplore(const ExploreCommandOptions& options) {
 
 Runner addExploreCommand(CLI::App& app) {
     auto options = std::make_shared<ExploreCommandOptions>();
-    CLI::App* command = app.add_subcommand(
-        "explore", "Render a contact sheet of random constants (seeded, reproducible), skipping empty slices;\n"
-                   "writes sheet.png and, per tile, tile_NN.png and tile_NN.json to continue with");
+    CLI::App* command =
+        app.add_subcommand("explore",
+                           "Render a contact sheet of random constants (seeded, reproducible), skipping empty slices;\n"
+                           "writes sheet.png and, per tile, tile_NN.png and tile_NN.json to continue with");
     options->fractal.addTo(*command);
     command->add_option("--seed", options->seed, "Random seed (the same seed gives the same constants)");
     command->add_option("--count", options->count, "Number of tiles")->check(CLI::Range(1, 100));
     command->add_option("--columns", options->columns, "Tiles per row")->check(CLI::Range(1, 20));
     command->add_option("--tile-width", options->width, "Tile width in pixels")->check(CLI::Range(16, 4096));
     command->add_option("--tile-height", options->height, "Tile height in pixels")->check(CLI::Range(16, 4096));
-    command->add_option("-s,--samples", options->samples, "Anti-aliasing per tile: S x S rays a pixel")->check(CLI::Range(1, 8));
+    command->add_option("-s,--samples", options->samples, "Anti-aliasing per tile: S x S rays a pixel")
+        ->check(CLI::Range(1, 8));
     command->add_option("-o,--output", options->folder, "Folder for the sheet, tiles and parameter files");
     command->add_flag("-f,--force", options->force, "Overwrite an existing sheet");
     command->add_flag("-q,--quiet", options->quiet, "No progress bar or summary");

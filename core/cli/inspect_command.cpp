@@ -26,10 +26,12 @@ int runInspect(const InspectOptions& options) {
 Runner addInspectCommand(CLI::App& app) {
     auto options = std::make_shared<InspectOptions>();
     CLI::App* command = app.add_subcommand(
-        "inspect", "Report the variant, containment radius, each part's equivalent complex constant and whether it\n"
-                   "lies in the Mandelbrot set, the fraction of the slice inside at N, and why a slice is empty");
+        "inspect",
+        "Report the variant, containment radius, each part's equivalent complex constant and whether it\n"
+        "lies in the Mandelbrot set, the fraction of the slice inside at N, and why a slice is empty");
     options->fractal.addTo(*command);
-    command->add_option("--samples", options->samples, "Samples per axis for the inside fraction")->check(CLI::Range(2, 512));
+    command->add_option("--samples", options->samples, "Samples per axis for the inside fraction")
+        ->check(CLI::Range(2, 512));
     command->add_flag("--json", options->json, "Print JSON instead of text");
     return [options] { return reportErrors("inspect", [&] { return runInspect(*options); }); };
 }

@@ -8,14 +8,15 @@
 
 int main(int argc, char** argv) {
     using namespace dqj::cli;
-    CLI::App app{"dqjulia: dual-quaternion Julia fractals (zeta <- zeta^2 + c in 8-D, sliced to 3-D).\n"
-                 "Parameters come from a JSON file (--params) and flags, which override the file.",
-                 "dqjulia"};
+    CLI::App app{
+        "dqjulia: dual-quaternion Julia fractals (zeta <- zeta^2 + c in 8-D, sliced to 3-D).\n"
+        "Parameters come from a JSON file (--params) and flags, which override the file.",
+        "dqjulia"};
     app.set_version_flag("--version", std::string("dqjulia ") + dqj_version_string());
     app.require_subcommand(1);
     std::map<CLI::App*, Runner> runners;
-    for (auto add : {addRenderCommand, addEvalCommand, addInspectCommand, addPovrayCommand, addExploreCommand, addSheetCommand, addBakeCommand, addMeshCommand,
-                     addSchemaCommand}) {
+    for (auto add : {addRenderCommand, addEvalCommand, addInspectCommand, addPovrayCommand, addExploreCommand,
+                     addSheetCommand, addBakeCommand, addMeshCommand, addSchemaCommand}) {
         const std::size_t before = app.get_subcommands({}).size();
         Runner runner = add(app);
         runners[app.get_subcommands({}).at(before)] = std::move(runner);

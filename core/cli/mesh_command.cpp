@@ -43,14 +43,15 @@ int runMesh(const BakeFlags& flags) {
         BakeStats stats;
         Mesh mesh;
         {
-            ProgressBar bar(frames.size() > 1 ? "meshing frame " + std::to_string(frames[index]) : "meshing", flags.quiet);
+            ProgressBar bar(frames.size() > 1 ? "meshing frame " + std::to_string(frames[index]) : "meshing",
+                            flags.quiet);
             try {
                 mesh = bakeMesh(perFrame[index], options, bakeProgress(bar, monitor), &stats);
             } catch (const Cancelled&) {
                 bar.finish();
                 if (index == 0) throw;
-                std::cerr << "dqjulia mesh: interrupted at frame " << frames[index] << "; frames " << frames.front() << " to "
-                          << frames[index - 1] << " were written, frame " << frames[index] << " was not\n";
+                std::cerr << "dqjulia mesh: interrupted at frame " << frames[index] << "; frames " << frames.front()
+                          << " to " << frames[index - 1] << " were written, frame " << frames[index] << " was not\n";
                 return kInterrupted;
             }
             bar.finish();
@@ -63,7 +64,8 @@ int runMesh(const BakeFlags& flags) {
         if (mesh.positions.empty()) {
             const std::string reason = inspect(perFrame[index]).emptyReason;
             std::cerr << "dqjulia mesh: warning: " << paths[index] << " is empty: "
-                      << (reason.empty() ? "nothing within the bounds is in the set at this resolution" : reason) << "\n";
+                      << (reason.empty() ? "nothing within the bounds is in the set at this resolution" : reason)
+                      << "\n";
         }
         if (!flags.quiet)
             std::cerr << "wrote " << paths[index] << " (" << mesh.positions.size() << " vertices, "

@@ -27,7 +27,8 @@ struct PovrayOptions {
 };
 
 int runPovray(const PovrayOptions& options) {
-    Params params = options.fractal.paramsFile.empty() ? Params{} : loadParams(options.fractal.paramsFile, Validation::TypesOnly);
+    Params params =
+        options.fractal.paramsFile.empty() ? Params{} : loadParams(options.fractal.paramsFile, Validation::TypesOnly);
     options.fractal.applyTo(params);
     if (options.width) params.render.width = *options.width;
     if (options.height) params.render.height = *options.height;
@@ -41,8 +42,7 @@ int runPovray(const PovrayOptions& options) {
     validate(params);
     // An empty picture needs a reason, in POV-Ray as in `dqjulia render`.
     const std::string provenEmpty = provenEmptyReason(params);
-    if (!provenEmpty.empty())
-        std::cerr << "dqjulia povray: warning: the scene has no fractal: " << provenEmpty << "\n";
+    if (!provenEmpty.empty()) std::cerr << "dqjulia povray: warning: the scene has no fractal: " << provenEmpty << "\n";
 
     PovrayWriteOptions write;
     write.copyInclude = !options.noInclude;
@@ -55,8 +55,10 @@ int runPovray(const PovrayOptions& options) {
     // the include is fine (several scenes share one folder); a different one is not replaced silently.
     const PovrayFiles files = povrayFiles(params, options.output, write);
     std::vector<std::pair<std::string, std::string>> outputs;
-    for (const auto& [flag, path] : {std::pair<std::string, std::string>{"--output", files.scene}, {"--df3 (grid)", files.df3},
-                                     {"--df3 (scene)", files.df3Scene}, {"the include copy", files.include}})
+    for (const auto& [flag, path] : {std::pair<std::string, std::string>{"--output", files.scene},
+                                     {"--df3 (grid)", files.df3},
+                                     {"--df3 (scene)", files.df3Scene},
+                                     {"the include copy", files.include}})
         if (!path.empty()) outputs.emplace_back(flag, path);
     checkDistinctOutputs(outputs);
     if (!files.scene.empty()) checkOutputPath(files.scene, options.force);
@@ -96,13 +98,15 @@ int runPovray(const PovrayOptions& options) {
 Runner addPovrayCommand(CLI::App& app) {
     auto options = std::make_shared<PovrayOptions>();
     CLI::App* command = app.add_subcommand(
-        "povray", "Write a POV-Ray 3.7 scene (camera, lights, material, background) that draws what `render` draws,\n"
-                  "the fractal as an isosurface of the same distance estimate (dqjulia.inc, written beside it)");
+        "povray",
+        "Write a POV-Ray 3.7 scene (camera, lights, material, background) that draws what `render` draws,\n"
+        "the fractal as an isosurface of the same distance estimate (dqjulia.inc, written beside it)");
     options->fractal.addTo(*command);
     command->add_option("-o,--output", options->output, "Scene file to write, e.g. scene.pov")->required();
     command->add_option("-W,--width", options->width, "Image width the view is framed for");
     command->add_option("-H,--height", options->height, "Image height the view is framed for");
-    command->add_option("-s,--samples", options->samples, "Anti-aliasing: S x S rays per pixel (in the render command)");
+    command->add_option("-s,--samples", options->samples,
+                        "Anti-aliasing: S x S rays per pixel (in the render command)");
     command->add_option("--detail", options->detail, "Hit threshold in pixel footprints (smaller = finer)");
     command->add_option("--fov", options->fov, "Vertical field of view in degrees");
     command->add_option("--coloring", options->coloring, "solid, iterations or trap")

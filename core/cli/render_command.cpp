@@ -30,7 +30,8 @@ struct RenderOptions {
 };
 
 Params loadRenderParams(const RenderOptions& options) {
-    Params params = options.fractal.paramsFile.empty() ? Params{} : loadParams(options.fractal.paramsFile, Validation::TypesOnly);
+    Params params =
+        options.fractal.paramsFile.empty() ? Params{} : loadParams(options.fractal.paramsFile, Validation::TypesOnly);
     options.fractal.applyTo(params);
     if (options.output) {
         if (options.output->empty()) throw ParamError("output.path", "--output is empty; give a file name");
@@ -59,7 +60,8 @@ Params loadRenderParams(const RenderOptions& options) {
                                    : options.coloring == "iterations" ? Coloring::Iterations
                                                                       : Coloring::Trap;
     if (!options.cameraPosition.empty())
-        params.camera.position = glm::dvec3(options.cameraPosition[0], options.cameraPosition[1], options.cameraPosition[2]);
+        params.camera.position =
+            glm::dvec3(options.cameraPosition[0], options.cameraPosition[1], options.cameraPosition[2]);
     if (!options.cameraTarget.empty())
         params.camera.target = glm::dvec3(options.cameraTarget[0], options.cameraTarget[1], options.cameraTarget[2]);
     validate(params);
@@ -88,15 +90,17 @@ int runRender(const RenderOptions& options) {
     const RenderStats& stats = result.stats;
     if (stats.hitPixels == 0) {
         const std::string reason = provenEmpty.empty() ? inspect(params).emptyReason : provenEmpty;
-        std::cerr << "dqjulia render: warning: the image shows no surface: "
-                  << (reason.empty() ? "no ray came within the hit threshold; try more iterations, a larger --detail or another camera"
-                                     : reason)
-                  << "\n";
+        std::cerr
+            << "dqjulia render: warning: the image shows no surface: "
+            << (reason.empty()
+                    ? "no ray came within the hit threshold; try more iterations, a larger --detail or another camera"
+                    : reason)
+            << "\n";
     }
     if (!options.quiet)
-        std::cerr << "wrote " << params.output.path << " (" << params.render.width << "x" << params.render.height << ", "
-                  << stats.hitPixels << " pixels on the surface, " << std::fixed << std::setprecision(2) << stats.seconds
-                  << " s)\n";
+        std::cerr << "wrote " << params.output.path << " (" << params.render.width << "x" << params.render.height
+                  << ", " << stats.hitPixels << " pixels on the surface, " << std::fixed << std::setprecision(2)
+                  << stats.seconds << " s)\n";
     if (options.stats)
         std::cout << "rays " << stats.rays << "\nsteps " << stats.steps << "\nsteps_per_ray "
                   << (stats.rays ? double(stats.steps) / double(stats.rays) : 0.0) << "\nhit_pixels " << stats.hitPixels
@@ -110,7 +114,8 @@ Runner addRenderCommand(CLI::App& app) {
     auto options = std::make_shared<RenderOptions>();
     CLI::App* command = app.add_subcommand("render", "Render an image by sphere tracing the distance estimate");
     options->fractal.addTo(*command);
-    command->add_option("-o,--output", options->output, "Output image: .png (8-bit sRGB) or .exr (linear, depth, normals)");
+    command->add_option("-o,--output", options->output,
+                        "Output image: .png (8-bit sRGB) or .exr (linear, depth, normals)");
     command->add_option("--format", options->format, "png8, png16 or exr (default: from the file name)")
         ->check(CLI::IsMember({"png8", "png16", "exr"}));
     command->add_option("-W,--width", options->width, "Image width in pixels");
@@ -128,8 +133,9 @@ Runner addRenderCommand(CLI::App& app) {
     command->add_option("--camera-position", options->cameraPosition, "Camera position x y z")->expected(3);
     command->add_option("--camera-target", options->cameraTarget, "Camera target x y z")->expected(3);
     command->add_option("--save-params", options->saveParams, "Also write the complete parameter file used");
-    command->add_option("--voxels", options->voxels,
-                        "Draw the voxels of a baked VDB (its density grid) as cubes instead of tracing the fractal")
+    command
+        ->add_option("--voxels", options->voxels,
+                     "Draw the voxels of a baked VDB (its density grid) as cubes instead of tracing the fractal")
         ->check(CLI::ExistingFile);
     command->add_flag("-f,--force", options->force, "Overwrite existing output files");
     command->add_flag("-q,--quiet", options->quiet, "No progress bar or summary");

@@ -24,7 +24,8 @@ int runSheet(const SheetOptions& options) {
     checkOutputPath(options.output, options.force);
     std::vector<SheetTile> tiles;
     for (std::size_t index = 0; index < options.images.size(); ++index)
-        tiles.push_back({readPng(options.images[index]), options.labels.empty() ? options.images[index] : options.labels[index]});
+        tiles.push_back(
+            {readPng(options.images[index]), options.labels.empty() ? options.images[index] : options.labels[index]});
     SheetLayout layout;
     layout.columns = options.columns;
     layout.labelLines = options.labelLines;
@@ -37,11 +38,14 @@ int runSheet(const SheetOptions& options) {
 Runner addSheetCommand(CLI::App& app) {
     auto options = std::make_shared<SheetOptions>();
     CLI::App* command = app.add_subcommand("sheet", "Lay PNG images out in a contact sheet with a label under each");
-    command->add_option("-t,--tile", options->images, "A PNG image (repeat, in order)")->required()->check(CLI::ExistingFile);
+    command->add_option("-t,--tile", options->images, "A PNG image (repeat, in order)")
+        ->required()
+        ->check(CLI::ExistingFile);
     command->add_option("-l,--label", options->labels, "Its label (repeat, one per --tile; \\n breaks lines)");
     command->add_option("-o,--output", options->output, "The sheet (.png)")->required();
     command->add_option("--columns", options->columns, "Tiles per row")->check(CLI::Range(1, 20));
-    command->add_option("--label-lines", options->labelLines, "Text lines reserved under each tile")->check(CLI::Range(0, 20));
+    command->add_option("--label-lines", options->labelLines, "Text lines reserved under each tile")
+        ->check(CLI::Range(0, 20));
     command->add_flag("-f,--force", options->force, "Overwrite an existing sheet");
     return [options] { return reportErrors("sheet", [&] { return runSheet(*options); }); };
 }

@@ -59,22 +59,27 @@ std::string checkVdbContainer(std::istream& in, std::uint64_t size) {
     std::uint32_t version = 0, major = 0, minor = 0;
     char hasOffsets = 0;
     if (!read(&magic, 8) || magic != openvdb::OPENVDB_MAGIC) return "not an OpenVDB file";
-    if (!read(&version, 4) || version < openvdb::OPENVDB_FILE_VERSION_NODE_MASK_COMPRESSION || version > openvdb::OPENVDB_FILE_VERSION)
+    if (!read(&version, 4) || version < openvdb::OPENVDB_FILE_VERSION_NODE_MASK_COMPRESSION ||
+        version > openvdb::OPENVDB_FILE_VERSION)
         return "unsupported OpenVDB file version " + std::to_string(version) + " (dqjulia reads versions " +
                std::to_string(openvdb::OPENVDB_FILE_VERSION_NODE_MASK_COMPRESSION) + " to " +
                std::to_string(openvdb::OPENVDB_FILE_VERSION) + ")";
-    if (!read(&major, 4) || !read(&minor, 4) || !read(&hasOffsets, 1) || !skip(36)) return "the file is truncated (in its header)";
+    if (!read(&major, 4) || !read(&minor, 4) || !read(&hasOffsets, 1) || !skip(36))
+        return "the file is truncated (in its header)";
     if (!hasOffsets) return "the file was written as a stream without grid offsets";
     if (!skipMetadata()) return "the file is truncated or damaged (in its metadata)";
     std::int32_t grids = 0;
-    if (!read(&grids, 4) || grids < 0 || std::uint64_t(grids) > size / 16) return "the file is truncated or damaged (its grid count)";
+    if (!read(&grids, 4) || grids < 0 || std::uint64_t(grids) > size / 16)
+        return "the file is truncated or damaged (its grid count)";
     for (std::int32_t index = 0; index < grids; ++index) {
         std::int64_t gridStart = 0, blockStart = 0, end = 0;
-        if (!skipString() || !skipString() || !skipString() || !read(&gridStart, 8) || !read(&blockStart, 8) || !read(&end, 8))
+        if (!skipString() || !skipString() || !skipString() || !read(&gridStart, 8) || !read(&blockStart, 8) ||
+            !read(&end, 8))
             return "the file is truncated or damaged (grid " + std::to_string(index + 1) + "'s descriptor)";
-        if (gridStart < std::int64_t(position) || blockStart < gridStart || end < blockStart || std::uint64_t(end) > size)
-            return "the file is truncated (grid " + std::to_string(index + 1) + " of " + std::to_string(grids) + " ends at byte " +
-                   std::to_string(end) + " of a file of " + std::to_string(size) + " bytes)";
+        if (gridStart < std::int64_t(position) || blockStart < gridStart || end < blockStart ||
+            std::uint64_t(end) > size)
+            return "the file is truncated (grid " + std::to_string(index + 1) + " of " + std::to_string(grids) +
+                   " ends at byte " + std::to_string(end) + " of a file of " + std::to_string(size) + " bytes)";
         position = std::uint64_t(end);
         in.seekg(std::streamoff(position));
         if (!in) return "the file is truncated";
@@ -115,7 +120,8 @@ openvdb::FloatGrid::ConstPtr readDensity(const std::string& path) {
         throw fail(shortMessage(error.what()));
     }
     auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
-    if (!grid) throw std::runtime_error("'" + path + "' has no float grid named \"density\" (bake it with dqjulia bake)");
+    if (!grid)
+        throw std::runtime_error("'" + path + "' has no float grid named \"density\" (bake it with dqjulia bake)");
     return grid;
 }
 
@@ -132,7 +138,8 @@ VoxelHit traverse(const openvdb::FloatGrid& grid, const openvdb::CoordBBox& box,
                   const glm::dvec3& direction) {
     const openvdb::math::Transform& transform = grid.transform();
     const openvdb::Vec3d origin = transform.worldToIndex(openvdb::Vec3d(eye.x, eye.y, eye.z));
-    const openvdb::Vec3d ahead = transform.worldToIndex(openvdb::Vec3d(eye.x + direction.x, eye.y + direction.y, eye.z + direction.z));
+    const openvdb::Vec3d ahead =
+        transform.worldToIndex(openvdb::Vec3d(eye.x + direction.x, eye.y + direction.y, eye.z + direction.z));
     // Shift by half a voxel so voxel (i, j, k) covers [i, i + 1); t stays in world units.
     const glm::dvec3 o(origin.x() + 0.5, origin.y() + 0.5, origin.z() + 0.5);
     const glm::dvec3 d(ahead.x() - origin.x(), ahead.y() - origin.y(), ahead.z() - origin.z());
@@ -163,7 +170,8 @@ VoxelHit traverse(const openvdb::FloatGrid& grid, const openvdb::CoordBBox& box,
         step[axis] = d[axis] > 0 ? 1 : -1;
         delta[axis] = d[axis] != 0.0 ? std::abs(1.0 / d[axis]) : std::numeric_limits<double>::infinity();
         const double boundary = d[axis] > 0 ? cell[axis] + 1.0 : cell[axis];
-        next[axis] = d[axis] != 0.0 ? tEnter + (boundary - start[axis]) / d[axis] : std::numeric_limits<double>::infinity();
+        next[axis] =
+            d[axis] != 0.0 ? tEnter + (boundary - start[axis]) / d[axis] : std::numeric_limits<double>::infinity();
     }
     auto accessor = grid.getConstAccessor();
     double t = tEnter;
@@ -213,11 +221,13 @@ RenderResult renderVoxels(const Params& params, const std::string& vdbPath, cons
                 const std::size_t pixel = std::size_t(y) * image.width + x;
                 for (int sy = 0; sy < samples; ++sy)
                     for (int sx = 0; sx < samples; ++sx) {
-                        const glm::dvec3 direction = camera.rayDirection(x + (sx + 0.5) / samples, y + (sy + 0.5) / samples);
+                        const glm::dvec3 direction =
+                            camera.rayDirection(x + (sx + 0.5) / samples, y + (sy + 0.5) / samples);
                         const VoxelHit hit = box.empty() ? VoxelHit{} : traverse(*grid, box, camera.eye, direction);
                         if (!hit.hit) {
                             // The same vertical gradient as render()'s background.
-                            const double height = glm::dot(direction, camera.up) / glm::dot(direction, camera.forward) / camera.tanHalfFov;
+                            const double height = glm::dot(direction, camera.up) / glm::dot(direction, camera.forward) /
+                                                  camera.tanHalfFov;
                             const double mix = std::clamp(0.5 + 0.5 * height, 0.0, 1.0);
                             colour += settings.backgroundBottom * (1.0 - mix) + settings.backgroundTop * mix;
                             continue;

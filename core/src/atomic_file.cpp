@@ -43,7 +43,9 @@ mode_t currentUmask() {
 /// writes are continued, EINTR retried) and keeps the first error's errno.
 class CheckedBuffer : public std::streambuf {
 public:
-    explicit CheckedBuffer(int fd) : fd_(fd), buffer_(1 << 16) { setp(buffer_.data(), buffer_.data() + buffer_.size()); }
+    explicit CheckedBuffer(int fd) : fd_(fd), buffer_(1 << 16) {
+        setp(buffer_.data(), buffer_.data() + buffer_.size());
+    }
     int error() const { return error_; }
     /// Writes out what is buffered; false (and error()) on failure.
     bool drain() {
@@ -74,7 +76,9 @@ protected:
     int sync() override { return drain() ? 0 : -1; }
     pos_type seekoff(off_type offset, std::ios_base::seekdir direction, std::ios_base::openmode) override {
         if (!drain()) return pos_type(off_type(-1));
-        const int whence = direction == std::ios_base::beg ? SEEK_SET : direction == std::ios_base::cur ? SEEK_CUR : SEEK_END;
+        const int whence = direction == std::ios_base::beg   ? SEEK_SET
+                           : direction == std::ios_base::cur ? SEEK_CUR
+                                                             : SEEK_END;
         const off_t position = ::lseek(fd_, off_t(offset), whence);
         if (position < 0) {
             if (!error_) error_ = errno;
@@ -195,7 +199,8 @@ std::string AtomicFile::failureMessage(const std::string& path, const std::strin
     return printableText("cannot write '" + path + "': " + reason);
 }
 
-AtomicFile::AtomicFile(std::string path, Existing existing) : path_(std::move(path)), state_(std::make_unique<State>()) {
+AtomicFile::AtomicFile(std::string path, Existing existing)
+    : path_(std::move(path)), state_(std::make_unique<State>()) {
     State& state = *state_;
     state.existing = existing;
     if (path_.empty() || !std::filesystem::path(path_).has_filename()) throw failure(path_, "not a file name");
@@ -289,7 +294,8 @@ void AtomicFile::commit() {
     } else if (::rename(state.tempPath.c_str(), path_.c_str()) != 0) {
         error = errno;
     }
-    if (error == EEXIST) throw failure(path_, "the file appeared while dqjulia worked and is kept (pass --force to overwrite it)");
+    if (error == EEXIST)
+        throw failure(path_, "the file appeared while dqjulia worked and is kept (pass --force to overwrite it)");
     if (error) throw systemError(path_, error);
     state.committed = true;
     // Make the new name durable; best effort, since the data is already in place.

@@ -121,7 +121,9 @@ void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, 
         grids.push_back(grid);
         return grid;
     };
-    if (color) assemble(colorLeaves, openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f)), "color")->setVectorType(openvdb::VEC_INVARIANT);
+    if (color)
+        assemble(colorLeaves, openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f)), "color")
+            ->setVectorType(openvdb::VEC_INVARIANT);
     if (trap) assemble(trapLeaves, openvdb::FloatGrid::create(0.0f), "trap");
     if (iterations) assemble(iterationLeaves, openvdb::FloatGrid::create(0.0f), "iterations");
 }
@@ -143,7 +145,8 @@ openvdb::FloatGrid::Ptr bakeLevelSet(const Params& params, const BakeOptions& op
     parallelForWithProgress(1, progress.stage(BakeStage::LevelSet, sampledAt, rebuiltAt),
                             [&](std::size_t, const std::atomic<bool>& stop) {
                                 StopInterrupter interrupter(stop);
-                                surface = openvdb::tools::levelSetRebuild(*sampled.grid, 0.0f, band, band, nullptr, &interrupter);
+                                surface = openvdb::tools::levelSetRebuild(*sampled.grid, 0.0f, band, band, nullptr,
+                                                                          &interrupter);
                             });
     sampled.grid.reset();
     surface->setName("surface");
@@ -254,14 +257,17 @@ std::string_view bakeStageName(BakeStage stage) {
     return "working";
 }
 
-BakeStats bakeVdb(const Params& params, const std::string& path, const BakeOptions& options, const ProgressCallback& progress) {
+BakeStats bakeVdb(const Params& params, const std::string& path, const BakeOptions& options,
+                  const ProgressCallback& progress) {
     const auto start = std::chrono::steady_clock::now();
     validate(params);
-    if (AtomicFile::lowercaseExtension(path) != ".vdb") throw ParamError("output.path", "'" + path + "' must end in .vdb");
+    if (AtomicFile::lowercaseExtension(path) != ".vdb")
+        throw ParamError("output.path", "'" + path + "' must end in .vdb");
     AtomicFile file(path, options.existing);  // fails now, before the work, if the folder is not writable
     StagedProgress staged(progress, options.monitor);
     BakeStats stats;
-    openvdb::FloatGrid::Ptr surface = bakeLevelSet(params, options, bakeMemoryModel(params.bake), staged, stats, 0.7, 0.85);
+    openvdb::FloatGrid::Ptr surface =
+        bakeLevelSet(params, options, bakeMemoryModel(params.bake), staged, stats, 0.7, 0.85);
 
     openvdb::GridPtrVec grids;
     if (hasGrid(params.bake, BakeGrid::Surface)) grids.push_back(surface);

@@ -60,7 +60,8 @@ BallBound boundBall(const Fractal& fractal, const DualQuat& centre, double radiu
             b = square(b) + fractal.c.b;
             const double next = hypot2(norm(a), norm(b));
             if (!std::isfinite(next) || !std::isfinite(spread)) return result;
-            if (next + spread > bailout) least = std::min(least, leastEstimate(std::max(bailout, next - spread), derivative));
+            if (next + spread > bailout)
+                least = std::min(least, leastEstimate(std::max(bailout, next - spread), derivative));
             if (next - spread > bailout) {
                 result.allEscape = true;
                 result.minDe = least;
@@ -78,7 +79,8 @@ BallBound boundBall(const Fractal& fractal, const DualQuat& centre, double radiu
         if (testsDual) b.step(fractal.c.b);
         const double ra = a.norm();
         const double rb = testsDual ? b.norm() : 0.0;
-        if (!std::isfinite(ra) || !std::isfinite(a.spread) || !std::isfinite(rb) || !std::isfinite(b.spread)) return result;
+        if (!std::isfinite(ra) || !std::isfinite(a.spread) || !std::isfinite(rb) || !std::isfinite(b.spread))
+            return result;
         // A point escaping now has at least one part beyond R, and its DE is at least that part's.
         double now = kInfinity;
         bool possible = false;

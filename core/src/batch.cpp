@@ -168,8 +168,8 @@ HWY_INLINE void IterateVector(D d, const Constants<T>& constants, const T* const
         nOut = hn::IfThenElse(now, hn::Set(d, static_cast<T>(k)), nOut);
         raOut = hn::IfThenElse(now, ra, raOut);
         if constexpr (Var == Variant::Dual) {  // |b| is only needed at exit: keep b itself
-            bOut = {hn::IfThenElse(now, b.s, bOut.s), hn::IfThenElse(now, b.i, bOut.i), hn::IfThenElse(now, b.j, bOut.j),
-                    hn::IfThenElse(now, b.k, bOut.k)};
+            bOut = {hn::IfThenElse(now, b.s, bOut.s), hn::IfThenElse(now, b.i, bOut.i),
+                    hn::IfThenElse(now, b.j, bOut.j), hn::IfThenElse(now, b.k, bOut.k)};
         } else {
             rbOut = hn::IfThenElse(now, rb, rbOut);
         }
@@ -202,10 +202,12 @@ HWY_INLINE void IterateVector(D d, const Constants<T>& constants, const T* const
         de = StdMax(deA, deB);
     } else if constexpr (Var == Variant::PaperCoupled) {
         r = r8Out;
-        de = hn::IfThenElseZero(escaped, PartEstimate(d, hn::IfThenElse(escaped, r8Out, two), hn::IfThenElse(escaped, daOut, one)));
+        de = hn::IfThenElseZero(escaped, PartEstimate(d, hn::IfThenElse(escaped, r8Out, two),
+                                                      hn::IfThenElse(escaped, daOut, one)));
     } else {
         r = raOut;
-        de = hn::IfThenElseZero(escaped, PartEstimate(d, hn::IfThenElse(escaped, raOut, two), hn::IfThenElse(escaped, daOut, one)));
+        de = hn::IfThenElseZero(escaped, PartEstimate(d, hn::IfThenElse(escaped, raOut, two),
+                                                      hn::IfThenElse(escaped, daOut, one)));
     }
     hn::StoreU(nOut, d, out[0]);
     hn::StoreU(r, d, out[1]);
@@ -231,8 +233,8 @@ void IterateAll(const Constants<T>& constants, const PointBatch<T>& points, cons
     for (; first + lanes <= points.count; first += lanes) {
         // Full vectors: the T results go straight to the caller's arrays, n through the buffer.
         for (int k = 0; k < 8; ++k) in[k] = points.coords[k] + first;
-        T* direct[6] = {buffer[0], results.r + first, results.ra + first, results.rb + first, results.de + first,
-                        results.trap + first};
+        T* direct[6] = {buffer[0],          results.r + first,  results.ra + first,
+                        results.rb + first, results.de + first, results.trap + first};
         IterateVector<Var>(d, constants, in, direct);
         for (std::size_t lane = 0; lane < lanes; ++lane)
             results.n[first + lane] = static_cast<std::int32_t>(buffer[0][lane]);

@@ -195,20 +195,22 @@ dqj_status withFileErrors(dqj_context_t& context, Work&& work) {
 void noteEmptyBake(dqj_context_t& context, const dqj::Params& params, bool empty) {
     if (!empty) return;
     const dqj::InspectReport report = dqj::inspect(params);
-    context.warning = "the bake found no surface: " +
-                      (report.emptyReason.empty() ? std::string("nothing within the bounds is in the set at this resolution; "
-                                                                "try more iterations or a higher resolution")
-                                                  : report.emptyReason);
+    context.warning =
+        "the bake found no surface: " +
+        (report.emptyReason.empty() ? std::string("nothing within the bounds is in the set at this resolution; "
+                                                  "try more iterations or a higher resolution")
+                                    : report.emptyReason);
 }
 
 /// After a render: if nothing was hit, say why on the context (a silent empty picture is a bug).
 void noteEmptyRender(dqj_context_t& context, const dqj::RenderResult& result) {
     if (result.stats.hitPixels != 0) return;
     const dqj::InspectReport report = dqj::inspect(context.params);
-    context.warning = "the render found no surface: " +
-                      (report.emptyReason.empty() ? std::string("no ray came within the hit threshold; try more iterations, "
-                                                                "a larger render.detail or another camera")
-                                                  : report.emptyReason);
+    context.warning =
+        "the render found no surface: " +
+        (report.emptyReason.empty() ? std::string("no ray came within the hit threshold; try more iterations, "
+                                                  "a larger render.detail or another camera")
+                                    : report.emptyReason);
 }
 
 }  // namespace
@@ -266,7 +268,7 @@ dqj_status dqj_context_destroy(dqj_context handle) {
         std::lock_guard lock(registryMutex);
         const auto it = registry().find(handleValue(handle));
         if (it == registry().end()) return DQJ_ERROR_INVALID_HANDLE;  // unknown or already destroyed: ignored
-        if (it->second.busy) return DQJ_ERROR_BUSY;                  // from inside its own call: refused
+        if (it->second.busy) return DQJ_ERROR_BUSY;                   // from inside its own call: refused
         doomed = std::move(it->second.context);
         registry().erase(it);
     }
@@ -300,11 +302,15 @@ dqj_status dqj_context_set_params_json(dqj_context context, const char* json) {
 }
 
 dqj_status dqj_context_get_params_json(dqj_context context, char* buffer, size_t capacity, size_t* outSize) {
-    return guarded(context, [&](dqj_context_t& self) { return copyText(self, dqj::toJson(self.params), buffer, capacity, outSize); });
+    return guarded(context, [&](dqj_context_t& self) {
+        return copyText(self, dqj::toJson(self.params), buffer, capacity, outSize);
+    });
 }
 
 dqj_status dqj_params_schema_json(dqj_context context, char* buffer, size_t capacity, size_t* outSize) {
-    return guarded(context, [&](dqj_context_t& self) { return copyText(self, dqj::schema::schemaJson(), buffer, capacity, outSize); });
+    return guarded(context, [&](dqj_context_t& self) {
+        return copyText(self, dqj::schema::schemaJson(), buffer, capacity, outSize);
+    });
 }
 
 dqj_status dqj_context_set_constant(dqj_context context, const double c[8]) {
@@ -450,7 +456,8 @@ dqj_status dqj_context_set_bake_resolution(dqj_context context, int resolution) 
 
 dqj_status dqj_context_set_frame(dqj_context context, double frame) {
     return guarded(context, [&](dqj_context_t& self) {
-        if (!std::isfinite(frame) || std::abs(frame) > 1e6) return invalidArgument(self, "frame must be a finite number within +-1e6");
+        if (!std::isfinite(frame) || std::abs(frame) > 1e6)
+            return invalidArgument(self, "frame must be a finite number within +-1e6");
         self.frame = frame;
         return DQJ_OK;
     });
@@ -470,8 +477,9 @@ dqj_status dqj_bake_vdb(dqj_context context, const char* path, dqj_progress_fn p
         dqj::BakeOptions options;
         options.memoryLimit = self.memoryLimit;
         dqj::BakeStats stats;
-        const dqj_status status =
-            withFileErrors(self, [&] { stats = dqj::bakeVdb(params, path, options, wrapProgress(progress, userData)); });
+        const dqj_status status = withFileErrors(self, [&] {
+            stats = dqj::bakeVdb(params, path, options, wrapProgress(progress, userData));
+        });
         if (status != DQJ_OK) return status;
         self.bakeStats = stats;
         noteEmptyBake(self, params, stats.activeVoxels == 0);
@@ -509,9 +517,10 @@ dqj_status dqj_mesh_copy(dqj_context context, float* positions, float* normals, 
         const size_t vertices = mesh.positions.size();
         if (vertices != 0 && (!positions || !triangles)) return invalidArgument(self, "positions or triangles is NULL");
         if (vertexCapacity < vertices || triangleCapacity < mesh.triangleCount())
-            return invalidArgument(self, "buffers too small: the mesh has " + std::to_string(vertices) + " vertices and " +
-                                             std::to_string(mesh.triangleCount()) + " triangles; capacities are " +
-                                             std::to_string(vertexCapacity) + " and " + std::to_string(triangleCapacity));
+            return invalidArgument(self, "buffers too small: the mesh has " + std::to_string(vertices) +
+                                             " vertices and " + std::to_string(mesh.triangleCount()) +
+                                             " triangles; capacities are " + std::to_string(vertexCapacity) + " and " +
+                                             std::to_string(triangleCapacity));
         if (colors && mesh.colors.size() != vertices)
             return invalidArgument(self, "the mesh has no colours (bake.mesh_colors is false); pass colors = NULL");
         for (size_t index = 0; index < vertices; ++index) {
@@ -530,7 +539,8 @@ dqj_status dqj_mesh_copy(dqj_context context, float* positions, float* normals, 
 dqj_status dqj_mesh_write(dqj_context context, const char* path) {
     return guarded(context, [&](dqj_context_t& self) {
         if (!path) return invalidArgument(self, "path is NULL");
-        if (self.mesh.positions.empty()) return invalidArgument(self, "the context has no mesh: call dqj_mesh_compute first");
+        if (self.mesh.positions.empty())
+            return invalidArgument(self, "the context has no mesh: call dqj_mesh_compute first");
         return withFileErrors(self, [&] { dqj::writeMesh(self.mesh, path); });
     });
 }

@@ -97,9 +97,9 @@ struct PngRead {
     PngError error;
     png_uint_32 width = 0;
     png_uint_32 height = 0;
-    int bitDepth = 8;      ///< after the transforms: 8 or 16, RGBA
-    bool srgb = true;      ///< false: plain power law with `gamma`
-    double gamma = 1.0;    ///< file gamma from gAMA: encoded = linear^gamma
+    int bitDepth = 8;    ///< after the transforms: 8 or 16, RGBA
+    bool srgb = true;    ///< false: plain power law with `gamma`
+    double gamma = 1.0;  ///< file gamma from gAMA: encoded = linear^gamma
 };
 
 /// Reads the header and sets the transforms that turn any PNG into 8- or 16-bit RGBA.
@@ -155,7 +155,8 @@ struct PngReadGuard {
 void checkImage(const Image& image, const std::string& path) {
     const std::size_t pixels = static_cast<std::size_t>(std::max(image.width, 0)) * std::max(image.height, 0);
     if (image.width <= 0 || image.height <= 0 || image.rgba.size() != 4 * pixels)
-        throw std::runtime_error(AtomicFile::failureMessage(path, "the image is empty or its pixel buffer has the wrong size"));
+        throw std::runtime_error(
+            AtomicFile::failureMessage(path, "the image is empty or its pixel buffer has the wrong size"));
     if (!image.depth.empty() && image.depth.size() != pixels)
         throw std::runtime_error(AtomicFile::failureMessage(path, "the depth buffer has the wrong size"));
     if (!image.normal.empty() && image.normal.size() != 3 * pixels)
@@ -218,7 +219,8 @@ void writeExr(const Image& image, const std::string& path, Existing existing) {
     std::vector<half> rgba(4 * pixels);
     for (std::size_t pixel = 0; pixel < pixels; ++pixel) {
         for (int channel = 0; channel < 3; ++channel)
-            rgba[4 * pixel + channel] = half(haveSurface ? image.surface[3 * pixel + channel] : image.rgba[4 * pixel + channel]);
+            rgba[4 * pixel + channel] =
+                half(haveSurface ? image.surface[3 * pixel + channel] : image.rgba[4 * pixel + channel]);
         rgba[4 * pixel + 3] = half(image.rgba[4 * pixel + 3]);
     }
     // Misses have depth +inf in memory; in the file they get 1e10, as Blender writes for its
@@ -247,8 +249,8 @@ void writeExr(const Image& image, const std::string& path, Existing existing) {
         char* base = reinterpret_cast<char*>(const_cast<float*>(image.normal.data()));
         for (int channel = 0; channel < 3; ++channel) {
             header.channels().insert(normalNames[channel], Imf::Channel(Imf::FLOAT));
-            frame.insert(normalNames[channel], Imf::Slice(Imf::FLOAT, base + channel * sizeof(float),
-                                                          3 * sizeof(float), 3 * sizeof(float) * width));
+            frame.insert(normalNames[channel], Imf::Slice(Imf::FLOAT, base + channel * sizeof(float), 3 * sizeof(float),
+                                                          3 * sizeof(float) * width));
         }
     }
 
@@ -301,7 +303,9 @@ Image readPng(const std::string& path) {
     if (!readPngRows(&read, rows.data())) throw fail(read.error.message);
 
     const double maximum = read.bitDepth == 16 ? 65535.0 : 255.0;
-    auto toLinear = [&](double encoded) { return read.srgb ? decodeSrgb(encoded) : std::pow(encoded, 1.0 / read.gamma); };
+    auto toLinear = [&](double encoded) {
+        return read.srgb ? decodeSrgb(encoded) : std::pow(encoded, 1.0 / read.gamma);
+    };
     // 8-bit files: decode the 256 possible values once.
     std::array<float, 256> table{};
     for (int value = 0; value < 256; ++value) table[value] = static_cast<float>(toLinear(value / 255.0));

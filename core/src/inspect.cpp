@@ -24,7 +24,8 @@ std::string quatText(const Quat& q) {
 }
 
 std::string complexText(const PartReport& part) {
-    return number(part.complexReal) + (part.complexImaginary < 0 ? " - " : " + ") + number(std::abs(part.complexImaginary)) + "i";
+    return number(part.complexReal) + (part.complexImaginary < 0 ? " - " : " + ") +
+           number(std::abs(part.complexImaginary)) + "i";
 }
 
 /// Iteration at which the quaternion orbit of `start` under q^2 + c passes `bailout`; 0 if not within `limit`.
@@ -48,23 +49,26 @@ std::string partName(bool real) { return real ? "real part a" : "dual part b"; }
 /// "The slice holds the dual part fixed at b = (...); its orbit under c_b escapes at iteration k..."
 std::string fixedPartReason(const Fractal& fractal, const Slice& slice, bool real) {
     const int first = real ? 0 : 4;
-    const Quat fixed = makeQuat(slice.origin[first], slice.origin[first + 1], slice.origin[first + 2], slice.origin[first + 3]);
+    const Quat fixed =
+        makeQuat(slice.origin[first], slice.origin[first + 1], slice.origin[first + 2], slice.origin[first + 3]);
     const Quat c = real ? fractal.c.a : fractal.c.b;
     const int escape = quaternionEscape(fixed, c, fractal.bailout, fractal.iterations);
     if (escape == 0) return "";
     const PartReport part = inspectPart(c);
     const char* letter = real ? "a" : "b";
-    std::string reason = "the slice holds the " + partName(real) + " fixed at " + letter + " = " + quatText(fixed) +
-                         ", and that orbit escapes under c_" + letter + " = " + quatText(c) + " at iteration " +
-                         std::to_string(escape) + ", so every point of the slice escapes: the slice is empty for N >= " +
-                         std::to_string(escape) + " (N is " + std::to_string(fractal.iterations) + ").";
+    std::string reason =
+        "the slice holds the " + partName(real) + " fixed at " + letter + " = " + quatText(fixed) +
+        ", and that orbit escapes under c_" + letter + " = " + quatText(c) + " at iteration " + std::to_string(escape) +
+        ", so every point of the slice escapes: the slice is empty for N >= " + std::to_string(escape) + " (N is " +
+        std::to_string(fractal.iterations) + ").";
     if (!part.inMandelbrot)
         reason += " The " + partName(real) + "'s equivalent complex constant " + complexText(part) +
                   " lies outside the Mandelbrot set, so K(c_" + letter + ") is dust and no fixed " + letter +
-                  " stays bounded; choose a constant whose " + partName(real) + " is inside the Mandelbrot set, or a slice along " +
-                  letter + "'s axes.";
+                  " stays bounded; choose a constant whose " + partName(real) +
+                  " is inside the Mandelbrot set, or a slice along " + letter + "'s axes.";
     else
-        reason += " Choose a slice origin whose " + partName(real) + " lies in K(c_" + std::string(letter) + "), e.g. 0.";
+        reason +=
+            " Choose a slice origin whose " + partName(real) + " lies in K(c_" + std::string(letter) + "), e.g. 0.";
     return reason;
 }
 
@@ -134,8 +138,9 @@ InspectReport inspect(const Params& params, int samplesPerAxis) {
     report.insideFraction = double(inside) / report.samples;
 
     if (report.emptyReason.empty() && inside == 0) {
-        std::string reason = "no sampled point of the slice's bounds is inside the set at N = " +
-                             std::to_string(fractal.iterations) + " (" + std::to_string(report.samples) + " samples).";
+        std::string reason =
+            "no sampled point of the slice's bounds is inside the set at N = " + std::to_string(fractal.iterations) +
+            " (" + std::to_string(report.samples) + " samples).";
         for (bool real : {true, false}) {
             if (!real && fractal.variant == Variant::Dual) continue;
             const PartReport& part = real ? report.real : report.dual;
@@ -154,28 +159,33 @@ std::string formatReport(const InspectReport& report) {
     const Fractal& fractal = report.fractal;
     out << "variant:             " << variantName(fractal.variant) << "\n";
     out << "iterations N:        " << fractal.iterations << "\n";
-    out << "bailout R:           " << number(fractal.bailout, 6) << " (at least " << number(minimumBailout(fractal), 6) << ")\n";
+    out << "bailout R:           " << number(fractal.bailout, 6) << " (at least " << number(minimumBailout(fractal), 6)
+        << ")\n";
     for (bool real : {true, false}) {
         const PartReport& part = real ? report.real : report.dual;
         out << (real ? "real part c_a:       " : "dual part c_b:       ") << quatText(part.c) << "\n";
         out << "  equivalent complex " << complexText(part) << ": "
-            << (part.inMandelbrot ? "inside the Mandelbrot set (did not escape in " + std::to_string(kMandelbrotIterations) + " iterations)"
-                                  : "OUTSIDE the Mandelbrot set (escapes at iteration " + std::to_string(part.mandelbrotEscape) + "): its Julia set is dust")
+            << (part.inMandelbrot ? "inside the Mandelbrot set (did not escape in " +
+                                        std::to_string(kMandelbrotIterations) + " iterations)"
+                                  : "OUTSIDE the Mandelbrot set (escapes at iteration " +
+                                        std::to_string(part.mandelbrotEscape) + "): its Julia set is dust")
             << "\n";
         out << "  containment radius r_K: " << number(part.containmentRadius, 6) << "\n";
     }
     if (fractal.variant == Variant::Dual)
         out << "note:                under variant dual only |a| decides escape; b is the derivative of a\n";
     if (report.bounds) {
-        out << "bounds:              centre (" << number(report.bounds->center.x) << ", " << number(report.bounds->center.y) << ", "
-            << number(report.bounds->center.z) << "), radius " << number(report.bounds->radius, 6)
+        out << "bounds:              centre (" << number(report.bounds->center.x) << ", "
+            << number(report.bounds->center.y) << ", " << number(report.bounds->center.z) << "), radius "
+            << number(report.bounds->radius, 6)
             << (report.bounds->clipped ? " (clipped: the set is an extrusion along a dual axis)" : "") << "\n";
         out << "inside fraction:     " << number(100.0 * report.insideFraction, 4) << "% of " << report.samples
             << " samples in the bounds' cube\n";
     } else {
         out << "bounds:              none (the slice misses the containment region)\n";
     }
-    out << "slice:               " << (report.emptyReason.empty() ? "not empty" : "EMPTY: " + report.emptyReason) << "\n";
+    out << "slice:               " << (report.emptyReason.empty() ? "not empty" : "EMPTY: " + report.emptyReason)
+        << "\n";
     return out.str();
 }
 

@@ -108,7 +108,8 @@ Json parseLimited(const std::string& text, const std::string& source) {
             case Event::array_start:
                 elementStarts();
                 if (frames.size() >= std::size_t(kMaxParamsDepth))
-                    throw ParamError("", source + ": arrays and objects nested deeper than " + std::to_string(kMaxParamsDepth) +
+                    throw ParamError("", source + ": arrays and objects nested deeper than " +
+                                             std::to_string(kMaxParamsDepth) +
                                              " levels; a parameter file needs at most 4");
                 frames.emplace_back();
                 frames.back().object = event == Event::object_start;
@@ -118,8 +119,9 @@ Json parseLimited(const std::string& text, const std::string& source) {
                 frame.key = parsed.get<std::string>();
                 if (!frame.keys.insert(frame.key).second) {
                     const std::string key = path(frame.key);
-                    throw ParamError(key, source + ": " + key + ": duplicate key \"" + frame.key +
-                                              "\" (a key may appear once in an object; the second would replace the first)");
+                    throw ParamError(key,
+                                     source + ": " + key + ": duplicate key \"" + frame.key +
+                                         "\" (a key may appear once in an object; the second would replace the first)");
                 }
                 break;
             }

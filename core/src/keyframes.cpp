@@ -47,7 +47,8 @@ std::vector<double> trackValue(const Track& track, double frame) {
         const double m0 = smoothSlope(keys, index, component) * span;
         const double m1 = smoothSlope(keys, index + 1, component) * span;
         const double t2 = t * t, t3 = t2 * t;
-        value[component] = (2 * t3 - 3 * t2 + 1) * v0 + (t3 - 2 * t2 + t) * m0 + (-2 * t3 + 3 * t2) * v1 + (t3 - t2) * m1;
+        value[component] =
+            (2 * t3 - 3 * t2 + 1) * v0 + (t3 - 2 * t2 + t) * m0 + (-2 * t3 + 3 * t2) * v1 + (t3 - t2) * m1;
     }
     return value;
 }
@@ -68,7 +69,8 @@ Params atFrame(const Params& params, double frame) {
             case AnimatedValue::Iterations: result.fractal.iterations = std::max(1, int(std::lround(value[0]))); break;
             case AnimatedValue::Bailout: result.fractal.bailout = value[0]; break;
             case AnimatedValue::RotationDegrees:
-                if (track.rotation < int(result.slice.rotations.size())) result.slice.rotations[track.rotation].degrees = value[0];
+                if (track.rotation < int(result.slice.rotations.size()))
+                    result.slice.rotations[track.rotation].degrees = value[0];
                 break;
         }
     }

@@ -56,7 +56,8 @@ void removeDegenerateFaces(Mesh& mesh) {
     std::uint32_t distinct[4];
     std::size_t kept = 0;
     for (const auto& triangle : mesh.triangles)
-        if (distinctCorners(triangle.data(), 3, distinct) == 3) mesh.triangles[kept++] = {distinct[0], distinct[1], distinct[2]};
+        if (distinctCorners(triangle.data(), 3, distinct) == 3)
+            mesh.triangles[kept++] = {distinct[0], distinct[1], distinct[2]};
     mesh.triangles.resize(kept);
     kept = 0;
     for (const auto& quad : mesh.quads) {
@@ -90,7 +91,8 @@ void removeDegenerateFaces(Mesh& mesh) {
 std::vector<glm::vec3> vertexNormals(const Mesh& mesh) {
     std::vector<glm::vec3> normals(mesh.positions.size(), glm::vec3(0.0f));
     auto addTriangle = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
-        const glm::vec3 normal = glm::cross(mesh.positions[b] - mesh.positions[a], mesh.positions[c] - mesh.positions[a]);
+        const glm::vec3 normal =
+            glm::cross(mesh.positions[b] - mesh.positions[a], mesh.positions[c] - mesh.positions[a]);
         normals[a] += normal;
         normals[b] += normal;
         normals[c] += normal;
@@ -151,15 +153,15 @@ void writePly(const Mesh& mesh, std::ostream& out) {
 void writeObj(const Mesh& mesh, std::ostream& out) {
     const bool colors = !mesh.colors.empty();
     out << "# dqjulia " << DQJ_VERSION_STRING << ": " << mesh.positions.size() << " vertices, "
-        << mesh.triangles.size() + mesh.quads.size() << " faces" << (colors ? "; vertex colours (sRGB) after x y z" : "")
-        << "\n";
+        << mesh.triangles.size() + mesh.quads.size() << " faces"
+        << (colors ? "; vertex colours (sRGB) after x y z" : "") << "\n";
     char line[160];
     for (std::size_t index = 0; index < mesh.positions.size(); ++index) {
         const glm::vec3& p = mesh.positions[index];
         if (colors) {
             const glm::vec3& c = mesh.colors[index];
-            std::snprintf(line, sizeof line, "v %.7g %.7g %.7g %.4f %.4f %.4f\n", p.x, p.y, p.z, linearToSrgb8(c.x) / 255.0,
-                          linearToSrgb8(c.y) / 255.0, linearToSrgb8(c.z) / 255.0);
+            std::snprintf(line, sizeof line, "v %.7g %.7g %.7g %.4f %.4f %.4f\n", p.x, p.y, p.z,
+                          linearToSrgb8(c.x) / 255.0, linearToSrgb8(c.y) / 255.0, linearToSrgb8(c.z) / 255.0);
         } else {
             std::snprintf(line, sizeof line, "v %.7g %.7g %.7g\n", p.x, p.y, p.z);
         }
@@ -175,8 +177,8 @@ void writeObj(const Mesh& mesh, std::ostream& out) {
         out << line;
     }
     for (const auto& quad : mesh.quads) {
-        std::snprintf(line, sizeof line, "f %u//%u %u//%u %u//%u %u//%u\n", quad[0] + 1, quad[0] + 1, quad[1] + 1, quad[1] + 1,
-                      quad[2] + 1, quad[2] + 1, quad[3] + 1, quad[3] + 1);
+        std::snprintf(line, sizeof line, "f %u//%u %u//%u %u//%u %u//%u\n", quad[0] + 1, quad[0] + 1, quad[1] + 1,
+                      quad[1] + 1, quad[2] + 1, quad[2] + 1, quad[3] + 1, quad[3] + 1);
         out << line;
     }
 }
@@ -248,16 +250,19 @@ Mesh bakeMesh(const Params& params, const BakeOptions& options, const ProgressCa
         mesh.colors.resize(mesh.positions.size());
         const Slice slice = params.slice.effective();
         const std::size_t tasks = (mesh.positions.size() + kVerticesPerTask - 1) / kVerticesPerTask;
-        parallelForWithProgress(tasks, staged.stage(BakeStage::Meshing, 0.9, 1.0), [&](std::size_t task, const std::atomic<bool>&) {
-            const std::size_t first = task * kVerticesPerTask;
-            const std::size_t end = std::min(mesh.positions.size(), (task + 1) * kVerticesPerTask);
-            thread_local BatchBuffer<double> batch;  // the task's vertices through the SIMD kernel together
-            batch.clear();
-            for (std::size_t index = first; index < end; ++index) batch.add(slice.map(glm::dvec3(mesh.positions[index])));
-            batch.evaluate(params.fractal);
-            for (std::size_t index = first; index < end; ++index)
-                mesh.colors[index] = glm::vec3(orbitColour(params.material, params.fractal, batch.escape(index - first)));
-        });
+        parallelForWithProgress(
+            tasks, staged.stage(BakeStage::Meshing, 0.9, 1.0), [&](std::size_t task, const std::atomic<bool>&) {
+                const std::size_t first = task * kVerticesPerTask;
+                const std::size_t end = std::min(mesh.positions.size(), (task + 1) * kVerticesPerTask);
+                thread_local BatchBuffer<double> batch;  // the task's vertices through the SIMD kernel together
+                batch.clear();
+                for (std::size_t index = first; index < end; ++index)
+                    batch.add(slice.map(glm::dvec3(mesh.positions[index])));
+                batch.evaluate(params.fractal);
+                for (std::size_t index = first; index < end; ++index)
+                    mesh.colors[index] =
+                        glm::vec3(orbitColour(params.material, params.fractal, batch.escape(index - first)));
+            });
         stats.evaluated += mesh.positions.size();
     } else if (progress && !progress(1.0)) {
         throw Cancelled();

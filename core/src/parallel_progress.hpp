@@ -41,19 +41,20 @@ inline void parallelForWithProgress(std::size_t count, const ProgressCallback& p
 
     // Items never throw into TBB: the first failure is kept and the rest are skipped.
     auto runItems = [&] {
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1), [&](const tbb::blocked_range<std::size_t>& range) {
-            for (std::size_t index = range.begin(); index != range.end(); ++index) {
-                if (stop.load(std::memory_order_relaxed)) return;
-                try {
-                    work(index, stop);
-                } catch (...) {
-                    std::lock_guard<std::mutex> lock(errorMutex);
-                    if (!error) error = std::current_exception();
-                    stop = true;
-                }
-                done.fetch_add(1, std::memory_order_relaxed);
-            }
-        });
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1),
+                          [&](const tbb::blocked_range<std::size_t>& range) {
+                              for (std::size_t index = range.begin(); index != range.end(); ++index) {
+                                  if (stop.load(std::memory_order_relaxed)) return;
+                                  try {
+                                      work(index, stop);
+                                  } catch (...) {
+                                      std::lock_guard<std::mutex> lock(errorMutex);
+                                      if (!error) error = std::current_exception();
+                                      stop = true;
+                                  }
+                                  done.fetch_add(1, std::memory_order_relaxed);
+                              }
+                          });
     };
 
     if (!progress) {

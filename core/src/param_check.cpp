@@ -28,12 +28,13 @@ void checkNumber(const Field& field, const Json& value, const std::string& key, 
     if (field.type == Type::Integer) {
         if (std::nearbyint(x) != x) fail(key, prefix, "must be a whole number, got " + describe(value));
         if (x < field.min || x > field.max)
-            fail(key, prefix, "must be a whole number from " + std::to_string(std::int64_t(field.min)) + " to " +
-                                  std::to_string(std::int64_t(field.max)) +
-                                  ", got " + formatNumber(x));
+            fail(key, prefix,
+                 "must be a whole number from " + std::to_string(std::int64_t(field.min)) + " to " +
+                     std::to_string(std::int64_t(field.max)) + ", got " + formatNumber(x));
         return;
     }
-    if (x < field.min || x > field.max || (field.minExclusive && x == field.min) || (field.maxExclusive && x == field.max))
+    if (x < field.min || x > field.max || (field.minExclusive && x == field.min) ||
+        (field.maxExclusive && x == field.max))
         fail(key, prefix,
              "must be " + std::string(field.minExclusive ? "greater than " : "at least ") + formatNumber(field.min) +
                  (field.maxExclusive ? " and less than " : " and at most ") + formatNumber(field.max) + ", got " +
@@ -52,14 +53,15 @@ void checkCount(const Field& field, const Json& value, const std::string& key, c
                 const std::string& what) {
     if (!value.is_array() || double(value.size()) < field.min || double(value.size()) > field.max)
         fail(key, prefix,
-             "must be an array of " + (field.min > 0 ? formatNumber(field.min) + " to " + formatNumber(field.max) + " "
-                                                     : std::string()) +
+             "must be an array of " +
+                 (field.min > 0 ? formatNumber(field.min) + " to " + formatNumber(field.max) + " " : std::string()) +
                  what + ", got " + describe(value));
 }
 
 std::string choiceList(const Field& field) {
     std::string allowed;
-    for (const schema::Choice& choice : field.choices) allowed += (allowed.empty() ? "" : ", ") + std::string(choice.name);
+    for (const schema::Choice& choice : field.choices)
+        allowed += (allowed.empty() ? "" : ", ") + std::string(choice.name);
     return allowed;
 }
 
@@ -67,7 +69,8 @@ void checkChoice(const Field& field, const Json& value, const std::string& key, 
     if (value.is_string())
         for (const schema::Choice& choice : field.choices)
             if (value.get<std::string>() == choice.name) return;
-    fail(key, prefix, "must be one of " + choiceList(field) + ", got " + (value.is_string() ? value.dump() : describe(value)));
+    fail(key, prefix,
+         "must be one of " + choiceList(field) + ", got " + (value.is_string() ? value.dump() : describe(value)));
 }
 
 void walk(const Json& node, const std::string& key) {
@@ -77,7 +80,8 @@ void walk(const Json& node, const std::string& key) {
         if (field && field->type == Type::Animation) return;  // its keys are parameter keys, checked by the reader
         for (const auto& item : node.items()) walk(item.value(), key.empty() ? item.key() : key + "." + item.key());
     } else if (node.is_array() && field && (field->type == Type::List || field->type == Type::ColorList)) {
-        for (std::size_t index = 0; index < node.size(); ++index) walk(node[index], key + "[" + std::to_string(index) + "]");
+        for (std::size_t index = 0; index < node.size(); ++index)
+            walk(node[index], key + "[" + std::to_string(index) + "]");
     }
 }
 

@@ -105,7 +105,8 @@ public:
                 }
             }
             std::string message = "unknown key \"" + item.key() + "\"";
-            if (best <= std::max<std::size_t>(2, item.key().size() / 3)) message += "; did you mean \"" + nearest + "\"?";
+            if (best <= std::max<std::size_t>(2, item.key().size() / 3))
+                message += "; did you mean \"" + nearest + "\"?";
             std::string allowed;
             for (const std::string& candidate : known_) allowed += (allowed.empty() ? "" : ", ") + candidate;
             fail(keyPath(item.key()), message + " (allowed here: " + allowed + ")");
@@ -151,7 +152,8 @@ void readSlice(ObjectReader reader, SliceSpec& slice) {
                                  describe(*value));
         }
     }
-    if (const Json* value = reader.find("origin")) slice.base.origin = reader.vec8(*value, "slice.origin", "slice.origin");
+    if (const Json* value = reader.find("origin"))
+        slice.base.origin = reader.vec8(*value, "slice.origin", "slice.origin");
     if (const Json* value = reader.find("rotations")) {
         const std::string key = reader.keyPath("rotations");
         if (!value->is_array())
@@ -166,8 +168,10 @@ void readSlice(ObjectReader reader, SliceSpec& slice) {
             const auto first = parseAxisName(plane.substr(0, comma));
             const auto second = comma == std::string::npos ? std::nullopt : parseAxisName(plane.substr(comma + 1));
             if (!first || !second || *first == *second)
-                item.fail(item.keyPath("plane"), "must name two different axes like \"a.j,b.s\" (axes: a.s a.i a.j a.k b.s "
-                                                 "b.i b.j b.k), got \"" + plane + "\"");
+                item.fail(item.keyPath("plane"),
+                          "must name two different axes like \"a.j,b.s\" (axes: a.s a.i a.j a.k b.s "
+                          "b.i b.j b.k), got \"" +
+                              plane + "\"");
             rotation.first = *first;
             rotation.second = *second;
             item.read("degrees", rotation.degrees);
@@ -198,7 +202,8 @@ void readCamera(ObjectReader reader, Camera& camera) {
 void readLights(ObjectReader& parent, const Json& value, std::vector<Light>& lights) {
     const std::string key = parent.keyPath("lights");
     if (!value.is_array())
-        parent.fail(key, "must be an array of lights {\"direction\", \"color\", \"intensity\"}, got " + describe(value));
+        parent.fail(key,
+                    "must be an array of lights {\"direction\", \"color\", \"intensity\"}, got " + describe(value));
     lights.clear();
     for (std::size_t index = 0; index < value.size(); ++index) {
         ObjectReader reader(value[index], indexed(key, index), parent.source());
@@ -304,9 +309,9 @@ void readAnimation(const Json& node, const std::string& source, std::vector<Trac
     std::string animatable;
     for (const schema::Field& field : schema::fields())
         if (field.has(schema::kAnimatable))
-            animatable += (animatable.empty() ? "" : ", ") +
-                          (field.key == "slice.rotations[].degrees" ? std::string("slice.rotations[i].degrees")
-                                                                     : std::string(field.key));
+            animatable += (animatable.empty() ? "" : ", ") + (field.key == "slice.rotations[].degrees"
+                                                                  ? std::string("slice.rotations[i].degrees")
+                                                                  : std::string(field.key));
     for (const auto& item : node.items()) {
         const std::string key = reader.keyPath(item.key());
         Track track;
@@ -325,8 +330,10 @@ void readAnimation(const Json& node, const std::string& source, std::vector<Trac
         const std::string animated = trackKey(track);
         const Json& keys = item.value();
         if (!keys.is_array() || keys.empty())
-            reader.fail(key, "must be a non-empty array of keys {\"frame\": 1, \"value\": ..., \"interpolation\": "
-                             "\"linear\"}, got " + describe(keys));
+            reader.fail(key,
+                        "must be a non-empty array of keys {\"frame\": 1, \"value\": ..., \"interpolation\": "
+                        "\"linear\"}, got " +
+                            describe(keys));
         for (std::size_t index = 0; index < keys.size(); ++index) {
             ObjectReader keyReader(keys[index], indexed(key, index), source);
             Keyframe keyframe;
@@ -334,7 +341,8 @@ void readAnimation(const Json& node, const std::string& source, std::vector<Trac
             const Json* value = keyReader.find("value");
             if (!frame || !value) keyReader.fail(keyReader.path(), "needs \"frame\" and \"value\"");
             if (!frame->is_number() || !std::isfinite(frame->get<double>()) || std::abs(frame->get<double>()) > 1e6)
-                keyReader.fail(keyReader.keyPath("frame"), "must be a number from -1e6 to 1e6, got " + describe(*frame));
+                keyReader.fail(keyReader.keyPath("frame"),
+                               "must be a number from -1e6 to 1e6, got " + describe(*frame));
             keyframe.frame = frame->get<double>();
             keyReader.checked(*value, keyReader.keyPath("value"), animated);
             if (track.target == AnimatedValue::Constant)
@@ -354,9 +362,9 @@ void readAnimation(const Json& node, const std::string& source, std::vector<Trac
             }
             keyReader.finish();
             if (!track.keys.empty() && !(keyframe.frame > track.keys.back().frame))
-                keyReader.fail(keyReader.keyPath("frame"), "frames must increase from key to key: " +
-                                                               formatNumber(keyframe.frame) + " follows " +
-                                                               formatNumber(track.keys.back().frame));
+                keyReader.fail(keyReader.keyPath("frame"),
+                               "frames must increase from key to key: " + formatNumber(keyframe.frame) + " follows " +
+                                   formatNumber(track.keys.back().frame));
             track.keys.push_back(keyframe);
         }
         tracks.push_back(track);
@@ -392,7 +400,8 @@ Params parseParams(const std::string& jsonText, const std::string& source, Valid
     }
     if (const Json* value = root.find("camera")) readCamera(ObjectReader(*value, "camera", source), params.camera);
     if (const Json* value = root.find("lights")) readLights(root, *value, params.lights);
-    if (const Json* value = root.find("material")) readMaterial(ObjectReader(*value, "material", source), params.material);
+    if (const Json* value = root.find("material"))
+        readMaterial(ObjectReader(*value, "material", source), params.material);
     if (const Json* value = root.find("render")) readRender(ObjectReader(*value, "render", source), params.render);
     if (const Json* value = root.find("output")) readOutput(ObjectReader(*value, "output", source), params.output);
     if (const Json* value = root.find("bake")) readBake(ObjectReader(*value, "bake", source), params.bake);
@@ -428,7 +437,8 @@ Params loadParams(const std::string& path, Validation validation) {
     if (error == EINTR) throw fail("interrupted");
     if (error) throw fail(std::strerror(error));
     if (text.size() > kMaxParamsBytes)
-        throw fail("larger than " + std::to_string(kMaxParamsBytes >> 20) + " MiB; a parameter file is a few kilobytes");
+        throw fail("larger than " + std::to_string(kMaxParamsBytes >> 20) +
+                   " MiB; a parameter file is a few kilobytes");
     return parseParams(text, path, validation);
 }
 

@@ -17,7 +17,8 @@ ImageFormat formatFor(const OutputSettings& output) {
     std::string extension;
     const std::size_t dot = output.path.rfind('.');
     if (dot != std::string::npos) extension = output.path.substr(dot + 1);
-    std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char ch) { return std::tolower(ch); });
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char ch) { return std::tolower(ch); });
     return extension == "exr" ? ImageFormat::Exr : ImageFormat::Png8;
 }
 

@@ -35,8 +35,9 @@ void validate(const Params& params) {
     detail::checkDocument(json::Json::parse(toJson(params)));
     const double needed = minimumBailout(fractal);
     if (!(fractal.bailout >= needed))
-        fail("fractal.bailout", "is " + formatNumber(fractal.bailout) + " but must be at least the containment radius r_K = " +
-                                    formatNumber(needed) + " of this constant and variant (points inside r_K may still be in the set)");
+        fail("fractal.bailout", "is " + formatNumber(fractal.bailout) +
+                                    " but must be at least the containment radius r_K = " + formatNumber(needed) +
+                                    " of this constant and variant (points inside r_K may still be in the set)");
 
     const Slice slice = params.slice.effective();
     const Stretch stretch = stretchOf(slice);
@@ -48,13 +49,15 @@ void validate(const Params& params) {
         double gram[3][3] = {};
         for (int row = 0; row < 3; ++row)
             for (int column = 0; column < 3; ++column)
-                for (int index = 0; index < 8; ++index) gram[row][column] += slice.axes[row][index] * slice.axes[column][index];
+                for (int index = 0; index < 8; ++index)
+                    gram[row][column] += slice.axes[row][index] * slice.axes[column][index];
         const double determinant = gram[0][0] * (gram[1][1] * gram[2][2] - gram[1][2] * gram[2][1]) -
                                    gram[0][1] * (gram[1][0] * gram[2][2] - gram[1][2] * gram[2][0]) +
                                    gram[0][2] * (gram[1][0] * gram[2][1] - gram[1][1] * gram[2][0]);
         if (!(determinant > 1e-10 * gram[0][0] * gram[1][1] * gram[2][2]))
-            fail("slice.axes", "the three axes are linearly dependent (one is a combination of the others), so the slice "
-                               "is a plane, not 3-D; give three independent axes");
+            fail("slice.axes",
+                 "the three axes are linearly dependent (one is a combination of the others), so the slice "
+                 "is a plane, not 3-D; give three independent axes");
     }
 
     const Camera& camera = params.camera;
@@ -77,14 +80,19 @@ void validate(const Params& params) {
             fail("lights[" + std::to_string(index) + "].direction", "must not be the zero vector");
 
     if (params.render.normals == NormalMethod::Analytic && fractal.variant != Variant::Dual)
-        fail("render.normals", "\"analytic\" normals come from the dual part of the true algebra and need variant \"dual\"; "
-                               "use \"central\" or \"auto\" with variant \"" + std::string(variantName(fractal.variant)) + "\"");
+        fail("render.normals",
+             "\"analytic\" normals come from the dual part of the true algebra and need variant \"dual\"; "
+             "use \"central\" or \"auto\" with variant \"" +
+                 std::string(variantName(fractal.variant)) + "\"");
     if (params.output.path.empty()) fail("output.path", "must not be empty");
     if (!params.output.format) {
-        std::string extension = params.output.path.substr(std::min(params.output.path.size(), params.output.path.rfind('.')));
-        std::transform(extension.begin(), extension.end(), extension.begin(), [](unsigned char ch) { return std::tolower(ch); });
+        std::string extension =
+            params.output.path.substr(std::min(params.output.path.size(), params.output.path.rfind('.')));
+        std::transform(extension.begin(), extension.end(), extension.begin(),
+                       [](unsigned char ch) { return std::tolower(ch); });
         if (extension != ".png" && extension != ".exr")
-            fail("output.path", "\"" + params.output.path + "\" must end in .png or .exr (or set output.format to png8, png16 or exr)");
+            fail("output.path", "\"" + params.output.path +
+                                    "\" must end in .png or .exr (or set output.format to png8, png16 or exr)");
     }
 
     const BakeSettings& bake = params.bake;
@@ -97,8 +105,9 @@ void validate(const Params& params) {
     // the rules above (the frames between keys are checked when they are baked).
     for (const Track& track : params.animation) {
         if (track.target == AnimatedValue::RotationDegrees && track.rotation >= int(params.slice.rotations.size()))
-            fail("animation." + trackKey(track), "animates rotation " + std::to_string(track.rotation) + " but slice.rotations has " +
-                                                     std::to_string(params.slice.rotations.size()) + " (they count from 0)");
+            fail("animation." + trackKey(track),
+                 "animates rotation " + std::to_string(track.rotation) + " but slice.rotations has " +
+                     std::to_string(params.slice.rotations.size()) + " (they count from 0)");
         for (const Keyframe& key : track.keys) {
             Params still = atFrame(params, key.frame);
             still.animation.clear();

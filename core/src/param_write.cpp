@@ -35,8 +35,8 @@ std::string toJson(const Params& params) {
     slice["origin"] = vec8Json(params.slice.base.origin);
     slice["rotations"] = json::OrderedJson::array();
     for (const PlaneRotation& rotation : params.slice.rotations)
-        slice["rotations"].push_back({{"plane", axisName(rotation.first) + "," + axisName(rotation.second)},
-                                      {"degrees", rotation.degrees}});
+        slice["rotations"].push_back(
+            {{"plane", axisName(rotation.first) + "," + axisName(rotation.second)}, {"degrees", rotation.degrees}});
     document["slice"] = slice;
     if (params.bounds) {
         document["bounds"] = {{"center", vec3Json(params.bounds->center)}, {"radius", params.bounds->radius}};
@@ -52,8 +52,9 @@ std::string toJson(const Params& params) {
     document["camera"] = camera;
     document["lights"] = json::OrderedJson::array();
     for (const Light& light : params.lights)
-        document["lights"].push_back(
-            {{"direction", vec3Json(light.direction)}, {"color", vec3Json(light.color)}, {"intensity", light.intensity}});
+        document["lights"].push_back({{"direction", vec3Json(light.direction)},
+                                      {"color", vec3Json(light.color)},
+                                      {"intensity", light.intensity}});
     const Material& material = params.material;
     json::OrderedJson palette = json::OrderedJson::array();
     for (const glm::dvec3& color : material.palette) palette.push_back(vec3Json(color));
@@ -76,7 +77,8 @@ std::string toJson(const Params& params) {
                           {"max_steps", render.maxSteps},
                           {"detail", render.detail},
                           {"normals", normalMethodName(render.normals)},
-                          {"background", {{"top", vec3Json(render.backgroundTop)}, {"bottom", vec3Json(render.backgroundBottom)}}}};
+                          {"background",
+                           {{"top", vec3Json(render.backgroundTop)}, {"bottom", vec3Json(render.backgroundBottom)}}}};
     json::OrderedJson output{{"path", params.output.path}};
     if (params.output.format) output["format"] = imageFormatName(*params.output.format);
     document["output"] = output;
@@ -98,8 +100,11 @@ std::string toJson(const Params& params) {
     for (const Track& track : params.animation) {
         json::OrderedJson keys = json::OrderedJson::array();
         for (const Keyframe& key : track.keys) {
-            json::OrderedJson value = track.target == AnimatedValue::Constant ? json::OrderedJson(key.value) : json::OrderedJson(key.value.at(0));
-            keys.push_back({{"frame", key.frame}, {"value", value}, {"interpolation", schema::choiceName("animation", int(key.interpolation))}});
+            json::OrderedJson value = track.target == AnimatedValue::Constant ? json::OrderedJson(key.value)
+                                                                              : json::OrderedJson(key.value.at(0));
+            keys.push_back({{"frame", key.frame},
+                            {"value", value},
+                            {"interpolation", schema::choiceName("animation", int(key.interpolation))}});
         }
         animation[trackKey(track)] = keys;
     }

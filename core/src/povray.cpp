@@ -349,8 +349,7 @@ std::string buildScene(const Params& params, const PovraySceneOptions& options) 
             << "// end of a render: it reports the steepest slope along the rays it traced, not over the grid.\n"
             << "object {\n"
             << "  DQJ_Isosurface_Custom(Fractal_Grid_Surface, Fractal_Center, Fractal_Radius, Fractal_Grid_Threshold,\n"
-            << "                        "
-            << number(grid.maxGradient + std::sqrt(3.0) / 255.0 / grid.spacing) << ", "
+            << "                        " << number(grid.maxGradient + std::sqrt(3.0) / 255.0 / grid.spacing) << ", "
             << number(grid.spacing / 8.0) << ")\n"
             << "  texture { Fractal_Texture }\n"
             << "}\n";
@@ -363,7 +362,8 @@ std::string buildScene(const Params& params, const PovraySceneOptions& options) 
 std::string_view povrayInclude() { return kPovrayIncludeText; }
 
 std::string povrayCommand(const Params& params, const std::string& scene) {
-    std::string command = "povray +W" + std::to_string(params.render.width) + " +H" + std::to_string(params.render.height);
+    std::string command =
+        "povray +W" + std::to_string(params.render.width) + " +H" + std::to_string(params.render.height);
     command += params.render.samples > 1 ? " +A0.0 +AM1 +R" + std::to_string(params.render.samples) : " -A";
     return command + " File_Gamma=sRGB +I" + scene;
 }
@@ -372,8 +372,9 @@ std::string povrayScene(const Params& params, const PovraySceneOptions& options)
 
 DensityGrid bakeDensityGrid(const Params& params, int resolution, const ProgressCallback& progress) {
     if (resolution < 2 || resolution > 512)
-        throw ParamError("df3.resolution", "the density grid's resolution must be from 2 to 512 samples per axis, got " +
-                                               std::to_string(resolution));
+        throw ParamError("df3.resolution",
+                         "the density grid's resolution must be from 2 to 512 samples per axis, got " +
+                             std::to_string(resolution));
     const SceneFacts facts = resolve(params);
     DensityGrid grid;
     grid.resolution = resolution;
@@ -439,7 +440,8 @@ PovrayFiles povrayFiles(const Params& params, const std::string& scenePath, cons
         throw std::runtime_error(AtomicFile::failureMessage(scenePath, "not a file name"));
     const fs::path folder = scene.parent_path();
     const std::string stem = (folder / scene.stem()).string();
-    if (params.fractal.iterations > kPovrayMaxIterations && !options.df3) throw iterationLimitError(params.fractal.iterations);
+    if (params.fractal.iterations > kPovrayMaxIterations && !options.df3)
+        throw iterationLimitError(params.fractal.iterations);
     PovrayFiles files;
     if (params.fractal.iterations <= kPovrayMaxIterations) files.scene = scenePath;
     if (options.df3) {

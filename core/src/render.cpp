@@ -31,10 +31,10 @@ namespace {
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr int kTileSize = 16;
 constexpr int kOcclusionSamples = 5;
-constexpr int kShadowSteps = 64;     // soft shadows are a look, not a measurement: cap their cost
-constexpr int kBisectionSteps = 8;   // refines a step that landed inside to 1/256 of the step
+constexpr int kShadowSteps = 64;    // soft shadows are a look, not a measurement: cap their cost
+constexpr int kBisectionSteps = 8;  // refines a step that landed inside to 1/256 of the step
 constexpr double kFootprintFloor = 1e-7;
-constexpr int kRaysPerPass = 1024;     // rays traced together: whole pixels of a tile
+constexpr int kRaysPerPass = 1024;  // rays traced together: whole pixels of a tile
 
 /// Where a ray meets a sphere: [near, far] along the ray, or nothing.
 struct Interval {
@@ -81,8 +81,8 @@ struct Probe {
 struct Trace {
     bool hit = false;
     double t = kInfinity;
-    Probe escape;           ///< at the hit point (outside the finite-N set when refined)
-    bool cutFace = false;   ///< started inside the set on the bounding sphere (a clipped set)
+    Probe escape;          ///< at the hit point (outside the finite-N set when refined)
+    bool cutFace = false;  ///< started inside the set on the bounding sphere (a clipped set)
     int steps = 0;
 };
 
@@ -140,7 +140,8 @@ public:
 
     /// Vertical gradient over the image: bottom colour at the bottom edge, top at the top.
     glm::dvec3 background(const glm::dvec3& direction) const {
-        const double height = glm::dot(direction, camera_.up) / glm::dot(direction, camera_.forward) / camera_.tanHalfFov;
+        const double height =
+            glm::dot(direction, camera_.up) / glm::dot(direction, camera_.forward) / camera_.tanHalfFov;
         const double mix = std::clamp(0.5 + 0.5 * height, 0.0, 1.0);
         return settings_.backgroundBottom * (1.0 - mix) + settings_.backgroundTop * mix;
     }
@@ -210,7 +211,8 @@ public:
                 }
                 return 6;
             case Stage::Occlusion:
-                for (int i = 1; i <= kOcclusionSamples; ++i) points.push_back(p_ + normal_ * (i * scene_->occlusionDelta_));
+                for (int i = 1; i <= kOcclusionSamples; ++i)
+                    points.push_back(p_ + normal_ * (i * scene_->occlusionDelta_));
                 return kOcclusionSamples;
             case Stage::Shadows: {
                 std::size_t count = 0;
@@ -684,16 +686,17 @@ RenderResult render(const Params& params, const ProgressCallback& progress, Rend
     std::atomic<std::uint64_t> rays{0};
     std::atomic<std::uint64_t> steps{0};
     std::atomic<std::uint64_t> hitPixels{0};
-    parallelForWithProgress(
-        static_cast<std::size_t>(tilesX) * tilesY, progress, [&](std::size_t index, const std::atomic<bool>&) {
-            const int x0 = static_cast<int>(index % tilesX) * kTileSize;
-            const int y0 = static_cast<int>(index / tilesX) * kTileSize;
-            const TileStats tile = renderTile(scene, engine, x0, y0, std::min(x0 + kTileSize, image.width),
-                                              std::min(y0 + kTileSize, image.height), image);
-            rays += tile.rays;
-            steps += tile.steps;
-            hitPixels += tile.hitPixels;
-        });
+    parallelForWithProgress(static_cast<std::size_t>(tilesX) * tilesY, progress,
+                            [&](std::size_t index, const std::atomic<bool>&) {
+                                const int x0 = static_cast<int>(index % tilesX) * kTileSize;
+                                const int y0 = static_cast<int>(index / tilesX) * kTileSize;
+                                const TileStats tile =
+                                    renderTile(scene, engine, x0, y0, std::min(x0 + kTileSize, image.width),
+                                               std::min(y0 + kTileSize, image.height), image);
+                                rays += tile.rays;
+                                steps += tile.steps;
+                                hitPixels += tile.hitPixels;
+                            });
 
     result.stats.rays = rays;
     result.stats.steps = steps;

@@ -193,7 +193,8 @@ Stretch stretchOf(const Slice& slice) {
     glm::dmat3 gram(0.0);
     for (int column = 0; column < 3; ++column)
         for (int row = 0; row < 3; ++row)
-            for (int index = 0; index < 8; ++index) gram[column][row] += slice.axes[column][index] * slice.axes[row][index];
+            for (int index = 0; index < 8; ++index)
+                gram[column][row] += slice.axes[column][index] * slice.axes[row][index];
     const auto eigenvalues = symmetricEigenvalues(gram);
     Stretch stretch;
     stretch.max = std::sqrt(std::max(0.0, *std::max_element(eigenvalues.begin(), eigenvalues.end())));

@@ -26,8 +26,8 @@ using FloatLeaf = openvdb::FloatTree::LeafNodeType;
 
 namespace {
 
-constexpr int kLeafSize = int(FloatLeaf::DIM);  // 8
-constexpr int kTopBlockSize = 64;               // classification starts with blocks this big
+constexpr int kLeafSize = int(FloatLeaf::DIM);                // 8
+constexpr int kTopBlockSize = 64;                             // classification starts with blocks this big
 constexpr double kFloatLeafBytes = sizeof(FloatLeaf) + 64.0;  // a leaf and its share of the tree
 
 /// A leaf's state during sampling, stored per leaf (key = origin / 8).
@@ -71,23 +71,25 @@ std::size_t pruneAwayFromSurface(openvdb::FloatTree& tree, float background) {
     leaves.reserve(tree.leafCount());
     for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) leaves.push_back(leaf.getLeaf());
     std::vector<char> prunable(leaves.size(), 0);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const tbb::blocked_range<std::size_t>& range) {
-        openvdb::tree::ValueAccessor<const openvdb::FloatTree> accessor(tree);
-        for (std::size_t index = range.begin(); index != range.end(); ++index) {
-            const FloatLeaf& leaf = *leaves[index];
-            bool inside = false;
-            for (auto value = leaf.cbeginValueAll(); value && !inside; ++value) inside = *value < 0.0f;
-            const Coord low = leaf.origin().offsetBy(-1), high = leaf.origin().offsetBy(kLeafSize);
-            for (int x = low.x(); x <= high.x() && !inside; ++x)
-                for (int y = low.y(); y <= high.y() && !inside; ++y)
-                    for (int z = low.z(); z <= high.z() && !inside; ++z) {
-                        const bool shell = x == low.x() || x == high.x() || y == low.y() || y == high.y() ||
-                                           z == low.z() || z == high.z();
-                        if (shell) inside = accessor.getValue(Coord(x, y, z)) < 0.0f;
-                    }
-            prunable[index] = !inside;
-        }
-    });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                          openvdb::tree::ValueAccessor<const openvdb::FloatTree> accessor(tree);
+                          for (std::size_t index = range.begin(); index != range.end(); ++index) {
+                              const FloatLeaf& leaf = *leaves[index];
+                              bool inside = false;
+                              for (auto value = leaf.cbeginValueAll(); value && !inside; ++value)
+                                  inside = *value < 0.0f;
+                              const Coord low = leaf.origin().offsetBy(-1), high = leaf.origin().offsetBy(kLeafSize);
+                              for (int x = low.x(); x <= high.x() && !inside; ++x)
+                                  for (int y = low.y(); y <= high.y() && !inside; ++y)
+                                      for (int z = low.z(); z <= high.z() && !inside; ++z) {
+                                          const bool shell = x == low.x() || x == high.x() || y == low.y() ||
+                                                             y == high.y() || z == low.z() || z == high.z();
+                                          if (shell) inside = accessor.getValue(Coord(x, y, z)) < 0.0f;
+                                      }
+                              prunable[index] = !inside;
+                          }
+                      });
     std::vector<Coord> origins;
     for (std::size_t index = 0; index < leaves.size(); ++index)
         if (prunable[index]) origins.push_back(leaves[index]->origin());
@@ -137,7 +139,7 @@ public:
         limit_ = std::min(requested, processLimit);
         processLimited_ = processLimit <= requested;  // defaultMemoryLimit() too may be the process limit
         limitSource_ = processLimited_ ? " (what this process may still allocate under its memory limits: ulimit -v, "
-                                                "ulimit -d or its cgroup's memory.max)"
+                                         "ulimit -d or its cgroup's memory.max)"
                        : options.memoryLimit ? ""
                                              : " (half of the available memory)";
     }
@@ -158,7 +160,8 @@ public:
         double begin = split, finish = split + 0.9 * (end - split);
         const std::vector<Coord> offsets = neighbourOffsets();
         while (!wave.empty()) {
-            std::vector<std::unique_ptr<FloatLeaf>> leaves = sampleLeaves(wave, progress_.stage(BakeStage::Sampling, begin, finish));
+            std::vector<std::unique_ptr<FloatLeaf>> leaves =
+                sampleLeaves(wave, progress_.stage(BakeStage::Sampling, begin, finish));
             std::vector<Coord> next;
             for (const auto& leaf : leaves) {
                 const Coord key = leafKey(leaf->origin());
@@ -167,7 +170,8 @@ public:
                     if (states_.getValue(neighbour) != kDeferred) continue;
                     if (!outsideTowards(*leaf, offset.x(), offset.y(), offset.z())) continue;
                     states_.setValue(neighbour, kQueued);
-                    next.push_back(leaf->origin().offsetBy(offset.x() * kLeafSize, offset.y() * kLeafSize, offset.z() * kLeafSize));
+                    next.push_back(leaf->origin().offsetBy(offset.x() * kLeafSize, offset.y() * kLeafSize,
+                                                           offset.z() * kLeafSize));
                 }
             }
             stats_.sampledLeaves += leaves.size();
@@ -181,7 +185,8 @@ public:
         for (auto it = states_.cbeginValueOn(); it; ++it) {
             if (*it != kDeferred) continue;
             const Coord key = it.getCoord();
-            tree->addTile(1, Coord(key.x() * kLeafSize, key.y() * kLeafSize, key.z() * kLeafSize), float(-f_.epsilon()), false);
+            tree->addTile(1, Coord(key.x() * kLeafSize, key.y() * kLeafSize, key.z() * kLeafSize), float(-f_.epsilon()),
+                          false);
             ++stats_.interiorLeaves;
         }
 
@@ -221,7 +226,8 @@ private:
         std::vector<Coord> blocks;
         for (int x = floorTo(lo_.x(), kTopBlockSize); x <= hi_.x(); x += kTopBlockSize)
             for (int y = floorTo(lo_.y(), kTopBlockSize); y <= hi_.y(); y += kTopBlockSize)
-                for (int z = floorTo(lo_.z(), kTopBlockSize); z <= hi_.z(); z += kTopBlockSize) blocks.emplace_back(x, y, z);
+                for (int z = floorTo(lo_.z(), kTopBlockSize); z <= hi_.z(); z += kTopBlockSize)
+                    blocks.emplace_back(x, y, z);
         std::vector<Lists> lists(blocks.size());
         std::atomic<std::uint64_t> surfaceLeaves{0};
         parallelForWithProgress(blocks.size(), progress_.stage(BakeStage::Classifying, 0.0, split),
@@ -288,12 +294,14 @@ private:
         const int half = size / 2;
         for (int x = 0; x < 2; ++x)
             for (int y = 0; y < 2; ++y)
-                for (int z = 0; z < 2; ++z) classifyBlock(origin.offsetBy(x * half, y * half, z * half), half, lists, evaluations);
+                for (int z = 0; z < 2; ++z)
+                    classifyBlock(origin.offsetBy(x * half, y * half, z * half), half, lists, evaluations);
     }
 
     /// Samples leaves in parallel, one task a leaf. A leaf's 4^3 quarters are tested first, and
     /// a proven quarter keeps the (positive) background: no surface cell touches it.
-    std::vector<std::unique_ptr<FloatLeaf>> sampleLeaves(const std::vector<Coord>& origins, const ProgressCallback& progress) {
+    std::vector<std::unique_ptr<FloatLeaf>> sampleLeaves(const std::vector<Coord>& origins,
+                                                         const ProgressCallback& progress) {
         std::vector<std::unique_ptr<FloatLeaf>> leaves(origins.size());
         constexpr int kQuarter = kLeafSize / 2;
         parallelForWithProgress(origins.size(), progress, [&](std::size_t index, const std::atomic<bool>& stop) {
@@ -305,7 +313,8 @@ private:
             std::size_t voxels = 0;
             for (int quarter = 0; quarter < 8; ++quarter) {
                 if (stop.load(std::memory_order_relaxed)) return;
-                const Coord corner((quarter & 1) * kQuarter, ((quarter >> 1) & 1) * kQuarter, ((quarter >> 2) & 1) * kQuarter);
+                const Coord corner((quarter & 1) * kQuarter, ((quarter >> 1) & 1) * kQuarter,
+                                   ((quarter >> 2) & 1) * kQuarter);
                 if (!options_.dense && provenEmpty(leaf->origin() + corner, kQuarter, count)) continue;
                 for (int x = 0; x < kQuarter; ++x)
                     for (int y = 0; y < kQuarter; ++y)
@@ -338,13 +347,18 @@ private:
         if (estimate <= limit_) return;
         const std::string limit = formatBytes(limit_) + limitSource_;
         const std::string blocks = std::to_string(leaves) + " blocks of 8^3 voxels to sample";
-        throw MemoryLimitError("resolution " + std::to_string(params_.bake.resolution) +
-                                   (final ? " needs an estimated " + formatBytes(estimate) + " (" + blocks + "), more than the limit of " + limit
-                                          : " needs more than the limit of " + limit + ": the first " + blocks + " already need " +
-                                                formatBytes(estimate)) +
-                                   (processLimited_ ? std::string("; lower the resolution, bake a smaller region (bake.bounds) or raise the process's limit")
-                                                    : std::string("; lower the resolution, bake a smaller region (bake.bounds) or raise the limit (--max-memory)")),
-                               estimate, limit_);
+        throw MemoryLimitError(
+            "resolution " + std::to_string(params_.bake.resolution) +
+                (final ? " needs an estimated " + formatBytes(estimate) + " (" + blocks + "), more than the limit of " +
+                             limit
+                       : " needs more than the limit of " + limit + ": the first " + blocks + " already need " +
+                             formatBytes(estimate)) +
+                (processLimited_
+                     ? std::string(
+                           "; lower the resolution, bake a smaller region (bake.bounds) or raise the process's limit")
+                     : std::string(
+                           "; lower the resolution, bake a smaller region (bake.bounds) or raise the limit (--max-memory)")),
+            estimate, limit_);
     }
 
     const Params& params_;

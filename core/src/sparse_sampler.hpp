@@ -58,11 +58,11 @@ public:
     const Slice& slice() const { return slice_; }
     const BakeRegion& region() const { return region_; }
     double voxelSize() const { return voxelSize_; }
-    double epsilon() const { return epsilon_; }      ///< eps = h / 4
-    double stretch() const { return stretch_; }      ///< the slice's largest stretch (3-D -> 8-D)
-    double stretchA() const { return stretchA_; }    ///< stretch into the real part alone
-    double stretchB() const { return stretchB_; }    ///< stretch into the dual part alone
-    float background() const { return background_; } ///< (band width + 1) * h
+    double epsilon() const { return epsilon_; }       ///< eps = h / 4
+    double stretch() const { return stretch_; }       ///< the slice's largest stretch (3-D -> 8-D)
+    double stretchA() const { return stretchA_; }     ///< stretch into the real part alone
+    double stretchB() const { return stretchB_; }     ///< stretch into the dual part alone
+    float background() const { return background_; }  ///< (band width + 1) * h
 
 private:
     float value(int n, double de, double regionDistance) const;  ///< f from an escape count and DE

@@ -48,17 +48,33 @@ from common import check, report  # noqa: E402
 # Silhouette agreement in the render and osl cases, at RENDER_SIZE with RENDER_SAMPLES.
 RENDER_SIZE = (240, 180)
 RENDER_SAMPLES = 8
-RENDER_BAKE_RESOLUTION = 64   # the render case's bakes
+RENDER_BAKE_RESOLUTION = 64  # the render case's bakes
 # The osl case's bake: a bake's solid is the set grown by a quarter voxel (bake.hpp's eps), and
 # its fog is interpolated between voxels, so at 64^3 its silhouette is about a pixel wider all
 # round than the exact set the OSL script computes (IoU 0.915 in 4.2); at 160^3 a voxel is
 # below a pixel (IoU 0.956 - 0.978). It bakes in about 2 s.
 OSL_BAKE_RESOLUTION = 160
-MESH_VOLUME_IOU = 0.90        # baked mesh against baked volume (measured 0.95 in 4.2 - 5.0)
-OSL_VOLUME_IOU = 0.95         # OSL volume against baked volume (the same density, computed twice)
+MESH_VOLUME_IOU = 0.90  # baked mesh against baked volume (measured 0.95 in 4.2 - 5.0)
+OSL_VOLUME_IOU = 0.95  # OSL volume against baked volume (the same density, computed twice)
 
-CASES = ["library", "cache", "save_as", "moved_project", "schema", "parameters", "presets", "slice", "keyframes", "bake_volume", "bake_mesh",
-         "bake_sequence", "cancel", "render", "osl", "disable"]
+CASES = [
+    "library",
+    "cache",
+    "save_as",
+    "moved_project",
+    "schema",
+    "parameters",
+    "presets",
+    "slice",
+    "keyframes",
+    "bake_volume",
+    "bake_mesh",
+    "bake_sequence",
+    "cancel",
+    "render",
+    "osl",
+    "disable",
+]
 
 
 def _arguments(parser):
@@ -77,7 +93,8 @@ dqjulia = common.install_addon(ARGS.zip, CACHE)
 MODULE = dqjulia.__name__
 animation, bakes, jobs, native, osl, preview, props, slicing = (
     common.submodule(dqjulia, name)
-    for name in ("animation", "bakes", "jobs", "native", "osl", "preview", "props", "slicing"))
+    for name in ("animation", "bakes", "jobs", "native", "osl", "preview", "props", "slicing")
+)
 
 ADDON_DIR = os.path.dirname(dqjulia.__file__)
 EXAMPLES = ARGS.examples or os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "examples")
@@ -141,6 +158,7 @@ class NoDeprecations:
 
     def __enter__(self):
         import warnings
+
         self._catcher = warnings.catch_warnings(record=True)
         self._caught = self._catcher.__enter__()
         warnings.simplefilter("always")
@@ -170,7 +188,7 @@ def without_animated_base_values(document):
         if key.startswith("fractal."):
             document["fractal"].pop(key.split(".")[1], None)
         elif key.startswith("slice.rotations["):
-            index = int(key[len("slice.rotations["):].split("]")[0])
+            index = int(key[len("slice.rotations[") :].split("]")[0])
             document["slice"]["rotations"][index].pop("degrees", None)
     return document
 
@@ -208,6 +226,7 @@ def setup_cycles(scene):
 def camera_on(scene, obj):
     """An orthographic camera looking at the object's bounds from (1, -1, 0.7)."""
     from mathutils import Vector
+
     center, radius, _clipped = preview.state_for(obj).bounds
     center = obj.matrix_world @ Vector(center)
     data = bpy.data.cameras.new("test camera")
@@ -259,10 +278,16 @@ def silhouette(alpha, name, level=0.1):
 def case_library():
     check(native.load_error() is None, "the native library loads: %s" % native.load_error())
     number, text = native.version()
-    check(number == native.EXPECTED_VERSION, "library version %s is the one the add-on expects (%s)"
-          % (text, native.version_text(native.EXPECTED_VERSION)))
-    check(native.library_path().startswith(ADDON_DIR) and os.path.isfile(native.library_path())
-          and not os.path.islink(native.library_path()), "the library is a real file inside the installed add-on")
+    check(
+        number == native.EXPECTED_VERSION,
+        "library version %s is the one the add-on expects (%s)" % (text, native.version_text(native.EXPECTED_VERSION)),
+    )
+    check(
+        native.library_path().startswith(ADDON_DIR)
+        and os.path.isfile(native.library_path())
+        and not os.path.islink(native.library_path()),
+        "the library is a real file inside the installed add-on",
+    )
     for feature in native.FEATURES:
         check(native.has_feature(feature), "the library has the feature %s" % feature)
     check(not native.has_feature("no-such-feature"), "an unknown feature is reported missing")
@@ -282,8 +307,10 @@ def case_library():
     native.EXPECTED_VERSION = (saved_expected // 10000 + 1) * 10000
     native.reset()
     message = native.load_error() or ""
-    check("version" in message and native.version_text(native.EXPECTED_VERSION) in message,
-          "wrong version: %r" % message[:160])
+    check(
+        "version" in message and native.version_text(native.EXPECTED_VERSION) in message,
+        "wrong version: %r" % message[:160],
+    )
     native.EXPECTED_VERSION = saved_expected
     native.reset()
     check(native.load_error() is None, "the right library loads again")
@@ -337,37 +364,49 @@ def case_save_as():
         obj.dqjulia.bake_resolution = 32
         if not bpy.data.filepath:
             result, error = common.call(bpy.ops.dqjulia.bake_volume, synchronous=True)
-            check(result == {"CANCELLED"} and "save the .blend" in error,
-                  "before the first save a volume bake asks to save first: %s" % error[:90])
+            check(
+                result == {"CANCELLED"} and "save the .blend" in error,
+                "before the first save a volume bake asks to save first: %s" % error[:90],
+            )
         v01 = os.path.join(folder, "v01.blend")
         bpy.ops.wm.save_as_mainfile(filepath=v01)
         volume = _bake_volume_of("Julia")
         stored = volume.data.filepath
         first = bpy.path.abspath(stored)
-        check(stored.startswith("//dqjulia_cache/v01/Julia/") and os.path.isfile(first),
-              "the bake is beside the .blend, stored relative: %s" % stored)
+        check(
+            stored.startswith("//dqjulia_cache/v01/Julia/") and os.path.isfile(first),
+            "the bake is beside the .blend, stored relative: %s" % stored,
+        )
         bpy.ops.wm.save_mainfile()
         v02 = os.path.join(folder, "v02.blend")
         bpy.ops.wm.save_as_mainfile(filepath=v02)
         bpy.data.objects["Julia"].dqjulia.iterations = 10
         volume = _bake_volume_of("Julia")
         second = bpy.path.abspath(volume.data.filepath)
-        check(volume.data.filepath.startswith("//dqjulia_cache/v02/Julia/") and os.path.isfile(second),
-              "after Save As the new bake goes to v02's folder: %s" % volume.data.filepath)
+        check(
+            volume.data.filepath.startswith("//dqjulia_cache/v02/Julia/") and os.path.isfile(second),
+            "after Save As the new bake goes to v02's folder: %s" % volume.data.filepath,
+        )
         check(os.path.isfile(first), "v01's bake is kept (v01.blend refers to it)")
         volume = _bake_volume_of("Julia")
         third = bpy.path.abspath(volume.data.filepath)
-        check(os.path.isfile(third) and not os.path.exists(second) and os.path.isfile(first),
-              "a re-bake before saving removes only the unsaved bake it replaces")
+        check(
+            os.path.isfile(third) and not os.path.exists(second) and os.path.isfile(first),
+            "a re-bake before saving removes only the unsaved bake it replaces",
+        )
         bpy.ops.wm.save_mainfile()
         bpy.ops.wm.open_mainfile(filepath=v01)
         volume = baked_child(bpy.data.objects["Julia"], "volume")
-        check(volume is not None and bpy.path.abspath(volume.data.filepath) == first and volume.data.grids.load(),
-              "v01.blend opens with its own bake, which loads")
+        check(
+            volume is not None and bpy.path.abspath(volume.data.filepath) == first and volume.data.grids.load(),
+            "v01.blend opens with its own bake, which loads",
+        )
         check(not bakes.missing_bakes(bpy.data.objects), "and nothing is reported missing")
         bpy.ops.wm.open_mainfile(filepath=v02)
         volume = baked_child(bpy.data.objects["Julia"], "volume")
-        check(bpy.path.abspath(volume.data.filepath) == third and volume.data.grids.load(), "v02.blend has its last bake")
+        check(
+            bpy.path.abspath(volume.data.filepath) == third and volume.data.grids.load(), "v02.blend has its last bake"
+        )
         clear_scene()
 
 
@@ -401,16 +440,20 @@ def case_moved_project():
 
         report("== a missing bake file is reported in the panel's check and the render log")
         os.remove(path)
-        check([item[0].name for item in bakes.missing_bakes(source.children)] == [volume.name],
-              "the missing file is found (the panel shows it)")
+        check(
+            [item[0].name for item in bakes.missing_bakes(source.children)] == [volume.name],
+            "the missing file is found (the panel shows it)",
+        )
         log = io.StringIO()
         saved, sys.stderr = sys.stderr, log
         try:
             render_alpha(scene, [volume], "missing-bake")
         finally:
             sys.stderr = saved
-        check("renders empty" in log.getvalue() and volume.name in log.getvalue(),
-              "the render log says so: %r" % log.getvalue().strip()[:140])
+        check(
+            "renders empty" in log.getvalue() and volume.name in log.getvalue(),
+            "the render log says so: %r" % log.getvalue().strip()[:140],
+        )
         clear_scene()
 
 
@@ -440,13 +483,18 @@ def _near_limit(blender, core, exclusive, inward):
 def case_schema():
     with native.Context() as context:
         library_schema = context.schema()
-    check(library_schema == props.SCHEMA, "the add-on's schema.json is the loaded library's (%d keys)"
-          % len(library_schema["fields"]))
+    check(
+        library_schema == props.SCHEMA,
+        "the add-on's schema.json is the loaded library's (%d keys)" % len(library_schema["fields"]),
+    )
     # Every key of the core's schema against the property the add-on built for it, read from
     # Blender's own description of the registered property (bl_rna), not from props.py.
-    groups = {"": bpy.types.Object.bl_rna.properties["dqjulia"].fixed_type,
-              "lights[].": props.DQJLight.bl_rna, "slice.rotations[].": props.DQJRotation.bl_rna,
-              "material.palette[]": props.DQJColor.bl_rna}
+    groups = {
+        "": bpy.types.Object.bl_rna.properties["dqjulia"].fixed_type,
+        "lights[].": props.DQJLight.bl_rna,
+        "slice.rotations[].": props.DQJRotation.bl_rna,
+        "material.palette[]": props.DQJColor.bl_rna,
+    }
     mapped = 0
     for field in library_schema["fields"]:
         key, kind = field["key"], field["type"]
@@ -454,8 +502,11 @@ def case_schema():
             continue
         prefix = next((p for p in groups if p and key.startswith(p)), "")
         rna = groups[prefix].properties
-        names = ([props.prop_name(key) + "_a", props.prop_name(key) + "_b"] if kind == "dual_quaternion"
-                 else [props.prop_name(key)])
+        names = (
+            [props.prop_name(key) + "_a", props.prop_name(key) + "_b"]
+            if kind == "dual_quaternion"
+            else [props.prop_name(key)]
+        )
         for index, name in enumerate(names):
             if not check(name in rna, "%s has its property %s" % (key, name)):
                 continue
@@ -464,7 +515,7 @@ def case_schema():
             if default is None or default == "auto":
                 default = field.get("initial", default)
             if kind == "dual_quaternion":
-                default = default[4 * index:4 * index + 4]
+                default = default[4 * index : 4 * index + 4]
             if kind in ("vec3", "color", "vec8", "dual_quaternion"):
                 got = list(prop.default_array)
             elif kind == "choice_set":
@@ -480,12 +531,21 @@ def case_schema():
             check(_same(got, default), "%s: the default %r is the core's %r" % (key, got, default))
             check(prop.name == field["label"] or kind == "dual_quaternion", "%s: labelled %r" % (key, field["label"]))
             if "min" in field and kind in ("integer", "number", "vec3", "color", "vec8", "dual_quaternion"):
-                check(_near_limit(prop.hard_min, field["min"], field.get("min_exclusive"), 1) and
-                      _near_limit(prop.hard_max, field["max"], field.get("max_exclusive"), -1),
-                      "%s: the range [%g, %g] is the core's [%g, %g]%s" % (
-                          key, prop.hard_min, prop.hard_max, field["min"], field["max"],
-                          " (exclusive limits just inside)" if "min_exclusive" in field or "max_exclusive" in field
-                          else ""))
+                check(
+                    _near_limit(prop.hard_min, field["min"], field.get("min_exclusive"), 1)
+                    and _near_limit(prop.hard_max, field["max"], field.get("max_exclusive"), -1),
+                    "%s: the range [%g, %g] is the core's [%g, %g]%s"
+                    % (
+                        key,
+                        prop.hard_min,
+                        prop.hard_max,
+                        field["min"],
+                        field["max"],
+                        " (exclusive limits just inside)"
+                        if "min_exclusive" in field or "max_exclusive" in field
+                        else "",
+                    ),
+                )
             mapped += 1
     check(mapped >= 45, "%d keys of the schema checked against their properties" % mapped)
     clear_scene()
@@ -500,14 +560,26 @@ def case_schema():
     for document in (unset, defaults):
         document.pop("lights")
         document["material"].pop("palette")
-    differences = ["%s.%s" % (section, key) for section in defaults if isinstance(defaults[section], dict)
-                   for key in defaults[section] if unset.get(section, {}).get(key) != defaults[section][key]]
+    differences = [
+        "%s.%s" % (section, key)
+        for section in defaults
+        if isinstance(defaults[section], dict)
+        for key in defaults[section]
+        if unset.get(section, {}).get(key) != defaults[section][key]
+    ]
     if unset != defaults:
-        report("properties: %s\ncore:       %s" % (json.dumps(unset, sort_keys=True), json.dumps(defaults, sort_keys=True)))
-    check(unset == defaults, "the properties' own defaults (an object never set from the core) are the core's "
-          "document, every key but the lists%s" % (": differ at %s" % differences if differences else ""))
-    check(obj.dqjulia.bake_resolution == defaults["bake"]["resolution"], "bake resolution %d is the core's %d"
-          % (obj.dqjulia.bake_resolution, defaults["bake"]["resolution"]))
+        report(
+            "properties: %s\ncore:       %s" % (json.dumps(unset, sort_keys=True), json.dumps(defaults, sort_keys=True))
+        )
+    check(
+        unset == defaults,
+        "the properties' own defaults (an object never set from the core) are the core's "
+        "document, every key but the lists%s" % (": differ at %s" % differences if differences else ""),
+    )
+    check(
+        obj.dqjulia.bake_resolution == defaults["bake"]["resolution"],
+        "bake resolution %d is the core's %d" % (obj.dqjulia.bake_resolution, defaults["bake"]["resolution"]),
+    )
 
 
 def case_parameters():
@@ -524,14 +596,19 @@ def case_parameters():
     check(state.error is None and state.bounds is not None, "its parameters validate; bounds %s" % (state.bounds,))
     check(abs(obj.empty_display_size - state.bounds[1]) < 1e-5, "the empty shows the bounds' radius")
     from mathutils import Vector
+
     up = obj.matrix_world.to_3x3() @ Vector((0.0, 1.0, 0.0))
     toward = obj.matrix_world.to_3x3() @ Vector((0.0, 0.0, 1.0))
-    check((up - Vector((0.0, 0.0, 1.0))).length < 1e-6 and (toward - Vector((0.0, -1.0, 0.0))).length < 1e-6,
-          "the slice's y is Blender's Z and its z faces the front view (-Y), as `dqjulia render` shows it")
+    check(
+        (up - Vector((0.0, 0.0, 1.0))).length < 1e-6 and (toward - Vector((0.0, -1.0, 0.0))).length < 1e-6,
+        "the slice's y is Blender's Z and its z faces the front view (-Y), as `dqjulia render` shows it",
+    )
     obj.dqjulia.bailout = 1.2
     state = preview.state_for(obj)
-    check(state.error is not None and "fractal.bailout" in state.error,
-          "an invalid value is reported with the core's message: %r" % (state.error or "")[:100])
+    check(
+        state.error is not None and "fractal.bailout" in state.error,
+        "an invalid value is reported with the core's message: %r" % (state.error or "")[:100],
+    )
     obj.dqjulia.bailout = 4.0
     check(preview.state_for(obj).error is None, "and the valid value clears it")
 
@@ -544,13 +621,17 @@ def case_presets():
     check(presets == examples, "the zip ships every example as a preset (%d)" % len(presets))
     first = operators_module()._preset_items(None, bpy.context)
     second = operators_module()._preset_items(None, bpy.context)
-    check(first is second and [item[0] for item in first] == presets,
-          "the preset menu's items are one kept list (%d items), not new strings each call" % len(first))
+    check(
+        first is second and [item[0] for item in first] == presets,
+        "the preset menu's items are one kept list (%d items), not new strings each call" % len(first),
+    )
     result = bpy.ops.dqjulia.load_preset(preset="paper-test2-1")
     check(result == {"FINISHED"}, "load preset paper-test2-1")
     state = preview.state_for(obj)
-    check("escapes" in state.empty_reason and not state.drawable,
-          "the empty slice of paper-test2-1 is explained: %r" % state.empty_reason[:90])
+    check(
+        "escapes" in state.empty_reason and not state.drawable,
+        "the empty slice of paper-test2-1 is explained: %r" % state.empty_reason[:90],
+    )
     for name in examples:
         path = os.path.join(EXAMPLES, name + ".json")
         result = bpy.ops.dqjulia.import_params(filepath=path)
@@ -558,13 +639,17 @@ def case_presets():
         result2 = bpy.ops.dqjulia.export_params(filepath=exported)
         expected = without_animated_base_values(core_document(path))
         got = without_animated_base_values(core_document(exported))
-        check(result == result2 == {"FINISHED"} and got == expected,
-              "%s: import then export gives the same document" % name)
+        check(
+            result == result2 == {"FINISHED"} and got == expected,
+            "%s: import then export gives the same document" % name,
+        )
     with open(os.path.join(ARGS.work, "bad.json"), "w") as file:
         file.write('{"fractal": {"iteratons": 8}}')
     result, error = common.call(bpy.ops.dqjulia.import_params, filepath=os.path.join(ARGS.work, "bad.json"))
-    check(result == {"CANCELLED"} and "did you mean" in error, "a bad file is refused with the core's message: %s"
-          % error[:110])
+    check(
+        result == {"CANCELLED"} and "did you mean" in error,
+        "a bad file is refused with the core's message: %s" % error[:110],
+    )
 
 
 def operators_module():
@@ -587,10 +672,13 @@ def case_slice():
     with native.Context(document) as context:
         through_core = context.evaluate_slice_points(points)
         through_python = context.evaluate_points([slicing.map_point(origin, axes, p) for p in points])
-    worst = max(abs(a.de - b.de) / max(1e-300, abs(a.de)) if a.de else abs(b.de)
-                for a, b in zip(through_core, through_python))
-    check(all(a.n == b.n for a, b in zip(through_core, through_python)) and worst < 1e-6,
-          "same escape counts and DE (max relative difference %.2g)" % worst)
+    worst = max(
+        abs(a.de - b.de) / max(1e-300, abs(a.de)) if a.de else abs(b.de) for a, b in zip(through_core, through_python)
+    )
+    check(
+        all(a.n == b.n for a, b in zip(through_core, through_python)) and worst < 1e-6,
+        "same escape counts and DE (max relative difference %.2g)" % worst,
+    )
     largest, smallest = slicing.stretch(axes)
     check(abs(largest - 1.0) < 1e-6 and abs(smallest - 1.0) < 1e-6, "rotations keep the stretch 1")
 
@@ -600,30 +688,38 @@ def case_keyframes():
     with NoDeprecations("keyframes"):
         obj = keyed_object()
     curves = sorted({curve.data_path for curve in animation.dqjulia_fcurves(obj)})
-    check(curves == ["dqjulia.c_a", "dqjulia.iterations", "dqjulia.rotations[0].degrees"],
-          "the keyframes are found as F-curves: %s" % curves)
+    check(
+        curves == ["dqjulia.c_a", "dqjulia.iterations", "dqjulia.rotations[0].degrees"],
+        "the keyframes are found as F-curves: %s" % curves,
+    )
     path = os.path.join(ARGS.work, "animated.json")
     result = bpy.ops.dqjulia.export_params(filepath=path)
     with open(path) as file:
         section = json.load(file)["animation"]
-    check(result == {"FINISHED"} and sorted(section) == ["fractal.c", "fractal.iterations",
-                                                          "slice.rotations[0].degrees"],
-          "export writes the animation tracks: %s" % sorted(section))
+    check(
+        result == {"FINISHED"} and sorted(section) == ["fractal.c", "fractal.iterations", "slice.rotations[0].degrees"],
+        "export writes the animation tracks: %s" % sorted(section),
+    )
     check([key["value"] for key in section["fractal.iterations"]] == [8, 14], "iterations keys 8 -> 14")
     check(abs(section["fractal.c"][1]["value"][0] + 0.3) < 1e-6, "the constant's key at frame 3: c[0] = -0.3")
     other = new_dqjulia()
     bpy.ops.dqjulia.import_params(filepath=path)
     curves = sorted({curve.data_path for curve in animation.dqjulia_fcurves(other)})
-    check(curves == ["dqjulia.c_a", "dqjulia.c_b", "dqjulia.iterations", "dqjulia.rotations[0].degrees"],
-          "import makes F-curves: %s" % curves)
+    check(
+        curves == ["dqjulia.c_a", "dqjulia.c_b", "dqjulia.iterations", "dqjulia.rotations[0].degrees"],
+        "import makes F-curves: %s" % curves,
+    )
     iterations = next(c for c in animation.dqjulia_fcurves(other) if c.data_path == "dqjulia.iterations")
-    check([(p.co.x, p.co.y) for p in iterations.keyframe_points] == [(1.0, 8.0), (3.0, 14.0)],
-          "the iterations curve has the file's keys")
+    check(
+        [(p.co.x, p.co.y) for p in iterations.keyframe_points] == [(1.0, 8.0), (3.0, 14.0)],
+        "the iterations curve has the file's keys",
+    )
     documents = animation.frame_documents(other, bpy.context.scene, [1, 2, 3])
-    check([d["fractal"]["iterations"] for d in documents][::2] == [8, 14]
-          and abs(documents[2]["slice"]["rotations"][0]["degrees"] - 60.0) < 1e-4,
-          "each frame's values come from the keyframes (iterations %s)"
-          % [d["fractal"]["iterations"] for d in documents])
+    check(
+        [d["fractal"]["iterations"] for d in documents][::2] == [8, 14]
+        and abs(documents[2]["slice"]["rotations"][0]["degrees"] - 60.0) < 1e-4,
+        "each frame's values come from the keyframes (iterations %s)" % [d["fractal"]["iterations"] for d in documents],
+    )
     bpy.ops.dqjulia.import_params(filepath=os.path.join(EXAMPLES, "paper-highres.json"))
     check(animation.dqjulia_fcurves(other) == [], "importing a file without animation clears the keyframes")
 
@@ -634,26 +730,34 @@ def case_bake_volume():
     make_active(obj)
     bpy.context.scene.frame_set(1)
     scene = bpy.context.scene
-    check(bakes.unrendered_sources(scene) == [obj], "before a bake the object renders nothing, and the panel and the "
-          "render log say so")
+    check(
+        bakes.unrendered_sources(scene) == [obj],
+        "before a bake the object renders nothing, and the panel and the render log say so",
+    )
     log = io.StringIO()
     saved, sys.stderr = sys.stderr, log
     try:
         bakes._report_missing_at_render(scene)
     finally:
         sys.stderr = saved
-    check("renders nothing" in log.getvalue() and "bake a volume" in log.getvalue(),
-          "the render log: %r" % log.getvalue().strip()[:120])
+    check(
+        "renders nothing" in log.getvalue() and "bake a volume" in log.getvalue(),
+        "the render log: %r" % log.getvalue().strip()[:120],
+    )
     with NoDeprecations("Bake Volume"):
         result = bpy.ops.dqjulia.bake_volume(synchronous=True)
     check(result == {"FINISHED"}, "Bake Volume finished")
     volume = baked_child(obj, "volume")
-    check(volume is not None and volume.type == "VOLUME" and volume.parent == obj, "a Volume object, child of the source")
+    check(
+        volume is not None and volume.type == "VOLUME" and volume.parent == obj, "a Volume object, child of the source"
+    )
     if volume is None:
         return
     first_file = volume.data.filepath
-    check(os.path.isfile(first_file) and first_file.startswith(CACHE) and not first_file.startswith(ADDON_DIR),
-          "its VDB is in the cache folder: %s" % first_file)
+    check(
+        os.path.isfile(first_file) and first_file.startswith(CACHE) and not first_file.startswith(ADDON_DIR),
+        "its VDB is in the cache folder: %s" % first_file,
+    )
     volume.data.grids.load()
     names = sorted(grid.name for grid in volume.data.grids)
     check("density" in names and "surface" in names, "grids %s include density and surface" % names)
@@ -661,14 +765,21 @@ def case_bake_volume():
     check(density.data_type == "FLOAT", "the density grid is a float grid (%s)" % density.data_type)
     material = volume.data.materials[0] if volume.data.materials else None
     node = material and next((n for n in material.node_tree.nodes if n.type == "PRINCIPLED_VOLUME"), None)
-    check(node is not None and node.inputs["Density Attribute"].default_value == "density",
-          "a Principled Volume material reads the density grid")
+    check(
+        node is not None and node.inputs["Density Attribute"].default_value == "density",
+        "a Principled Volume material reads the density grid",
+    )
     check(volume.matrix_world == obj.matrix_world, "the volume sits in the source's frame")
     check(not bakes.unrendered_sources(scene), "with its bake it renders")
     result = bpy.ops.dqjulia.bake_volume(synchronous=True)
     again = baked_child(obj, "volume")
-    check(result == {"FINISHED"} and again == volume and again.data.filepath != first_file
-          and not os.path.exists(first_file or ""), "a second bake replaces the first (object kept, old file removed)")
+    check(
+        result == {"FINISHED"}
+        and again == volume
+        and again.data.filepath != first_file
+        and not os.path.exists(first_file or ""),
+        "a second bake replaces the first (object kept, old file removed)",
+    )
 
 
 def case_bake_mesh():
@@ -689,8 +800,10 @@ def case_bake_mesh():
         context.mesh_compute()
         vertex_count, triangle_count = context.mesh_sizes()
         positions, normals, _colors, triangles = context.mesh_copy()
-    check(len(mesh.vertices) == vertex_count > 100 and len(mesh.polygons) == triangle_count > 100,
-          "%d vertices and %d triangles, as the core's mesh" % (len(mesh.vertices), len(mesh.polygons)))
+    check(
+        len(mesh.vertices) == vertex_count > 100 and len(mesh.polygons) == triangle_count > 100,
+        "%d vertices and %d triangles, as the core's mesh" % (len(mesh.vertices), len(mesh.polygons)),
+    )
     totals = array.array("i", [0]) * len(mesh.polygons)
     mesh.polygons.foreach_get("loop_total", totals)
     check(set(totals) == {3} and len(mesh.loops) == 3 * triangle_count, "all faces are triangles")
@@ -727,22 +840,29 @@ def case_bake_sequence():
     result = bpy.ops.dqjulia.bake_sequence(synchronous=True)
     check(result == {"FINISHED"}, "Bake Sequence finished")
     sequence = baked_child(obj, "sequence")
-    check(sequence is not None and sequence.data.is_sequence and sequence.data.frame_duration == 3,
-          "a Volume sequence of 3 frames")
+    check(
+        sequence is not None and sequence.data.is_sequence and sequence.data.frame_duration == 3,
+        "a Volume sequence of 3 frames",
+    )
     if sequence is None:
         return
     folder = os.path.dirname(sequence.data.filepath)
     names = sorted(os.listdir(folder))
-    check(len(names) == 3 and all(n.endswith("_%04d.vdb" % f) for n, f in zip(names, (1, 2, 3))),
-          "files name_0001.vdb ... name_0003.vdb: %s" % names)
+    check(
+        len(names) == 3 and all(n.endswith("_%04d.vdb" % f) for n, f in zip(names, (1, 2, 3))),
+        "files name_0001.vdb ... name_0003.vdb: %s" % names,
+    )
     sizes = []
     for frame in (1, 2, 3):
         scene.frame_set(frame)
         grids = sequence.evaluated_get(bpy.context.evaluated_depsgraph_get()).data.grids
         grids.load()
-        check(grids.frame == frame and grids.frame_filepath.endswith("_%04d.vdb" % frame)
-              and "density" in [grid.name for grid in grids],
-              "frame %d plays %s" % (frame, os.path.basename(grids.frame_filepath)))
+        check(
+            grids.frame == frame
+            and grids.frame_filepath.endswith("_%04d.vdb" % frame)
+            and "density" in [grid.name for grid in grids],
+            "frame %d plays %s" % (frame, os.path.basename(grids.frame_filepath)),
+        )
         sizes.append(os.path.getsize(grids.frame_filepath))
     check(len(set(sizes)) > 1, "the frames differ (keyframed iterations and rotation): sizes %s" % sizes)
 
@@ -750,18 +870,24 @@ def case_bake_sequence():
     operators = operators_module()
     document = operators._bake_document(obj, need_density=True)
     size, seconds = operators.estimate_sequence(document, [1, 2, 3], os.path.join(ARGS.work, "estimate"))
-    check(0.5 * sum(sizes) < size < 2.0 * sum(sizes) and seconds > 0,
-          "3 frames at 40: about %s and %s (the files hold %s)" % (
-              jobs.format_bytes(size), jobs.format_duration(seconds), jobs.format_bytes(sum(sizes))))
+    check(
+        0.5 * sum(sizes) < size < 2.0 * sum(sizes) and seconds > 0,
+        "3 frames at 40: about %s and %s (the files hold %s)"
+        % (jobs.format_bytes(size), jobs.format_duration(seconds), jobs.format_bytes(sum(sizes))),
+    )
     check(not os.listdir(os.path.join(ARGS.work, "estimate")), "the sample bakes leave no file")
     document["bake"]["resolution"] = 160
     big, slow = operators.estimate_sequence(document, list(range(1, 251)), os.path.join(ARGS.work, "estimate"))
-    check(big > 40 * size and slow > 40 * seconds, "250 frames at 160 cost far more: %s, %s"
-          % (jobs.format_bytes(big), jobs.format_duration(slow)))
+    check(
+        big > 40 * size and slow > 40 * seconds,
+        "250 frames at 160 cost far more: %s, %s" % (jobs.format_bytes(big), jobs.format_duration(slow)),
+    )
     job = jobs.Job("Bake sequence", [jobs.VolumeTask(document, "a"), jobs.VolumeTask(document, "b")])
     job.index, job.started = 1, time.monotonic() - 10.0
-    check(job.status_text().startswith("Bake sequence: 1 of 2 frames done, 50%") and "left" in job.status_text(),
-          "the progress says frames done and time left: %r" % job.status_text())
+    check(
+        job.status_text().startswith("Bake sequence: 1 of 2 frames done, 50%") and "left" in job.status_text(),
+        "the progress says frames done and time left: %r" % job.status_text(),
+    )
 
 
 def case_cancel():
@@ -788,12 +914,21 @@ def case_cancel():
             job.cancel()
         time.sleep(0.01)
     job.join()
-    check(job.state == jobs.Job.CANCELLED, "a threaded bake cancelled at %.0f%% stops (%.2f s after cancel)"
-          % (100 * max(fractions), job.finished - cancelled_at) if cancelled_at else "never cancelled")
-    check(loops > 10 and len(fractions) >= 3,  # at least 0, one fraction in between, and > 50 %
-          "the main thread ran %d loops meanwhile and saw %d progress values" % (loops, len(fractions)))
-    check(files_under(CACHE) == files_before and set(bpy.data.objects.keys()) == objects_before,
-          "no file and no object remain")
+    check(
+        job.state == jobs.Job.CANCELLED,
+        "a threaded bake cancelled at %.0f%% stops (%.2f s after cancel)"
+        % (100 * max(fractions), job.finished - cancelled_at)
+        if cancelled_at
+        else "never cancelled",
+    )
+    check(
+        loops > 10 and len(fractions) >= 3,  # at least 0, one fraction in between, and > 50 %
+        "the main thread ran %d loops meanwhile and saw %d progress values" % (loops, len(fractions)),
+    )
+    check(
+        files_under(CACHE) == files_before and set(bpy.data.objects.keys()) == objects_before,
+        "no file and no object remain",
+    )
     prefs = bpy.context.preferences.addons[MODULE].preferences
     blocker = os.path.join(ARGS.work, "not-a-folder")
     with open(blocker, "w") as file:
@@ -803,8 +938,10 @@ def case_cancel():
     for operator in (bpy.ops.dqjulia.bake_volume, bpy.ops.dqjulia.bake_sequence):
         result, error = common.call(operator, synchronous=True)
         check(result == {"CANCELLED"} and error, "a bake into an unusable folder fails, saying why: %s" % error[:110])
-    check(set(bpy.data.objects.keys()) == objects_before and files_under(CACHE) == files_before,
-          "and adds no object and no file")
+    check(
+        set(bpy.data.objects.keys()) == objects_before and files_under(CACHE) == files_before,
+        "and adds no object and no file",
+    )
     prefs.cache_dir = CACHE
     s.bailout = 1.2  # invalid: refused before any work
     result, error = common.call(bpy.ops.dqjulia.bake_mesh, synchronous=True)
@@ -835,24 +972,34 @@ def case_render():
     mask_volume = silhouette(alpha_volume, "baked volume")
     mask_mesh = silhouette(alpha_mesh, "baked mesh")
     iou = common.iou(mask_volume, mask_mesh)
-    report("IoU baked volume / baked mesh = %.4f (Blender %s, %dx%d, %d samples, %.1f s + %.1f s)"
-           % (iou, bpy.app.version_string, RENDER_SIZE[0], RENDER_SIZE[1], RENDER_SAMPLES, t_volume, t_mesh))
-    check(iou >= MESH_VOLUME_IOU, "the silhouettes of the baked volume and mesh agree: IoU %.4f >= %.2f"
-          % (iou, MESH_VOLUME_IOU))
+    report(
+        "IoU baked volume / baked mesh = %.4f (Blender %s, %dx%d, %d samples, %.1f s + %.1f s)"
+        % (iou, bpy.app.version_string, RENDER_SIZE[0], RENDER_SIZE[1], RENDER_SAMPLES, t_volume, t_mesh)
+    )
+    check(
+        iou >= MESH_VOLUME_IOU,
+        "the silhouettes of the baked volume and mesh agree: IoU %.4f >= %.2f" % (iou, MESH_VOLUME_IOU),
+    )
 
 
 def case_osl():
-    check(osl.available() == bool(bpy.app.build_options.cycles_osl), "OSL availability follows the build (%s)"
-          % bool(bpy.app.build_options.cycles_osl))
+    check(
+        osl.available() == bool(bpy.app.build_options.cycles_osl),
+        "OSL availability follows the build (%s)" % bool(bpy.app.build_options.cycles_osl),
+    )
     result = bpy.ops.dqjulia.open_osl_text()
-    check(result == {"FINISHED"} and "shader dqjulia_density" in bpy.data.texts[osl.TEXT_NAME].as_string(),
-          "the OSL script is available as a text block")
+    check(
+        result == {"FINISHED"} and "shader dqjulia_density" in bpy.data.texts[osl.TEXT_NAME].as_string(),
+        "the OSL script is available as a text block",
+    )
     if not osl.available():
         clear_scene()
         make_active(new_dqjulia())
         result, error = common.call(bpy.ops.dqjulia.add_osl_volume)
-        check(result == {"CANCELLED"} and "without Open Shading Language" in error,
-              "Add OSL Volume says why it cannot run: %s" % error[:80])
+        check(
+            result == {"CANCELLED"} and "without Open Shading Language" in error,
+            "Add OSL Volume says why it cannot run: %s" % error[:80],
+        )
         return
     scene, obj = render_scene_with_bakes(OSL_BAKE_RESOLUTION, mesh=False)
     engines = [item.identifier for item in bpy.types.RenderSettings.bl_rna.properties["engine"].enum_items]
@@ -866,16 +1013,20 @@ def case_osl():
     check(scene.render.engine == "CYCLES" and scene.cycles.shading_system, "the scene renders with Cycles and OSL")
     tree = cube.active_material.node_tree
     script = next(n for n in tree.nodes if n.bl_idname == "ShaderNodeScript")
-    check("Density" in script.outputs and "Iterations" in script.inputs,
-          "the script node is compiled: outputs %s" % [s.name for s in script.outputs])
+    check(
+        "Density" in script.outputs and "Iterations" in script.inputs,
+        "the script node is compiled: outputs %s" % [s.name for s in script.outputs],
+    )
     setup_cycles(scene)
     scene.cycles.shading_system = True
     volume = baked_child(obj, "volume")
     alpha_osl, t_osl = render_alpha(scene, {cube}, "osl")
     alpha_volume, t_volume = render_alpha(scene, {volume}, "volume")
     iou = common.iou(silhouette(alpha_osl, "OSL volume"), silhouette(alpha_volume, "baked volume"))
-    report("IoU OSL volume / baked volume = %.4f (Blender %s, %dx%d, %d samples, %.1f s + %.1f s)"
-           % (iou, bpy.app.version_string, RENDER_SIZE[0], RENDER_SIZE[1], RENDER_SAMPLES, t_osl, t_volume))
+    report(
+        "IoU OSL volume / baked volume = %.4f (Blender %s, %dx%d, %d samples, %.1f s + %.1f s)"
+        % (iou, bpy.app.version_string, RENDER_SIZE[0], RENDER_SIZE[1], RENDER_SAMPLES, t_osl, t_volume)
+    )
     check(iou >= OSL_VOLUME_IOU, "the OSL volume renders as the baked volume: IoU %.4f >= %.2f" % (iou, OSL_VOLUME_IOU))
     obj.dqjulia.iterations = 5
     with NoDeprecations("a frame change with an OSL volume"):
@@ -887,11 +1038,15 @@ def case_disable():
     clear_scene()
     new_dqjulia()
     result = bpy.ops.preferences.addon_disable(module=MODULE)
-    check(result == {"FINISHED"} and not hasattr(bpy.types.Object, "dqjulia")
-          and MODULE not in bpy.context.preferences.addons, "the add-on unregisters cleanly")
+    check(
+        result == {"FINISHED"}
+        and not hasattr(bpy.types.Object, "dqjulia")
+        and MODULE not in bpy.context.preferences.addons,
+        "the add-on unregisters cleanly",
+    )
 
 
-for name in (CASES if ARGS.case == "all" else [ARGS.case]):
+for name in CASES if ARGS.case == "all" else [ARGS.case]:
     report("== case %s" % name)
     globals()["case_" + name]()
 common.finish()

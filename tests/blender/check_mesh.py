@@ -18,18 +18,20 @@ def main(argv):
     before = set(bpy.data.objects)
     if path.endswith(".ply"):
         if "ply_import" in dir(bpy.ops.wm):  # (hasattr is always true on bpy.ops)
-            bpy.ops.wm.ply_import(filepath=path)    # Blender 3.6+: the C++ PLY importer
+            bpy.ops.wm.ply_import(filepath=path)  # Blender 3.6+: the C++ PLY importer
         else:
             bpy.ops.import_mesh.ply(filepath=path)  # Blender 3.4 - 3.5: the PLY add-on (gone in 4.0)
     else:
-        bpy.ops.wm.obj_import(filepath=path)        # Blender 3.4: the C++ OBJ importer
+        bpy.ops.wm.obj_import(filepath=path)  # Blender 3.4: the C++ OBJ importer
     added = [obj for obj in bpy.data.objects if obj not in before]
     if len(added) != 1 or added[0].type != "MESH":
         fail(f"expected one mesh object from {path}, got {added}")
     mesh = added[0].data
     if len(mesh.vertices) != vertices or len(mesh.polygons) != faces:
-        fail(f"{path}: Blender imported {len(mesh.vertices)} vertices and {len(mesh.polygons)} faces; "
-             f"dqjulia reported {vertices} and {faces}")
+        fail(
+            f"{path}: Blender imported {len(mesh.vertices)} vertices and {len(mesh.polygons)} faces; "
+            f"dqjulia reported {vertices} and {faces}"
+        )
     if not mesh.color_attributes:
         fail(f"{path}: no vertex colours imported")
     uses = {}
@@ -42,4 +44,4 @@ def main(argv):
     print(f"check_mesh: {path}: {vertices} vertices, {faces} faces, colours {mesh.color_attributes[0].name}: OK")
 
 
-main(sys.argv[sys.argv.index("--") + 1:])
+main(sys.argv[sys.argv.index("--") + 1 :])

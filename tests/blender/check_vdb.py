@@ -47,8 +47,10 @@ def main(argv):
             fail("importing the files made no volume object")
         volume = obj.data
         if not volume.is_sequence or volume.frame_duration != count or volume.frame_start != 1:
-            fail(f"not a sequence of {count} frames from frame 1: is_sequence={volume.is_sequence}, "
-                 f"frame_start={volume.frame_start}, frame_duration={volume.frame_duration}")
+            fail(
+                f"not a sequence of {count} frames from frame 1: is_sequence={volume.is_sequence}, "
+                f"frame_start={volume.frame_start}, frame_duration={volume.frame_duration}"
+            )
         # Last frame first: each check follows a real frame change. Blender 4.2 (bpy 4.2.23)
         # reports "NAME_0000.vdb not found" for a sequence that has not seen a frame change
         # since it was made (4.5, 5.0 and 3.4 load frame 1 at once).
@@ -74,4 +76,4 @@ def main(argv):
     print("check_vdb: OK")
 
 
-main(sys.argv[sys.argv.index("--") + 1:])
+main(sys.argv[sys.argv.index("--") + 1 :])

@@ -21,17 +21,19 @@ def bpy_wheel_python_modules():
     that folder on its path: put it on ours too, so a Script node compiles as it does there."""
     try:
         import oslquery  # noqa: F401
+
         return
     except ImportError:
         pass
-    folder = os.path.join(bpy.utils.resource_path("LOCAL"), "python", "lib",
-                          "python%d.%d" % sys.version_info[:2], "site-packages")
+    folder = os.path.join(
+        bpy.utils.resource_path("LOCAL"), "python", "lib", "python%d.%d" % sys.version_info[:2], "site-packages"
+    )
     if os.path.isdir(folder) and folder not in sys.path:
         sys.path.append(folder)
 
 
 def arguments(extra=None):
-    argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
+    argv = sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else []
     parser = argparse.ArgumentParser()
     parser.add_argument("--zip", required=True, help="build/dist/dqjulia_blender.zip")
     parser.add_argument("--work", required=True, help="a scratch folder (emptied first)")
@@ -44,13 +46,14 @@ def arguments(extra=None):
         bpy_wheel_python_modules()
     if os.path.isdir(args.work):
         import shutil
+
         shutil.rmtree(args.work)
     os.makedirs(args.work)
     return args
 
 
 def blender_kind():
-    """"bpy module" (a bpy wheel in a Python) or "blender" (the program running a script)."""
+    """ "bpy module" (a bpy wheel in a Python) or "blender" (the program running a script)."""
     return "bpy module" if not os.path.basename(bpy.app.binary_path or "").startswith("blender") else "blender"
 
 
@@ -65,13 +68,13 @@ def install_extension(zip_path):
     repository "user_default" (under BLENDER_USER_EXTENSIONS or BLENDER_USER_RESOURCES),
     enabled on install. Returns the add-on's module name (bl_ext.user_default.dqjulia)."""
     import addon_utils
+
     repos = bpy.context.preferences.extensions.repos
     repo = next((r for r in repos if r.module == "user_default"), None)
     check(repo is not None, "the user repository user_default exists (%s)" % [r.module for r in repos])
     if "package_install_files" not in dir(bpy.ops.extensions):  # bl_pkg off (it is on by default)
         addon_utils.enable("bl_pkg", default_set=True)
-    result = bpy.ops.extensions.package_install_files(filepath=zip_path, repo="user_default",
-                                                      enable_on_install=True)
+    result = bpy.ops.extensions.package_install_files(filepath=zip_path, repo="user_default", enable_on_install=True)
     check(result == {"FINISHED"}, "extensions.package_install_files returned %s" % result)
     return "bl_ext.user_default.dqjulia"
 
@@ -80,6 +83,7 @@ def install_addon(zip_path, cache_dir):
     """Installs and enables the add-on from the zip (an extension in 4.2+, else addon_install
     + addon_enable); returns the imported package. Its module name is package.__name__."""
     import importlib
+
     if uses_extensions():
         module = install_extension(zip_path)
         root = bpy.utils.user_resource("EXTENSIONS")
@@ -102,6 +106,7 @@ def install_addon(zip_path, cache_dir):
 
 def submodule(package, name):
     import importlib
+
     return importlib.import_module(package.__name__ + "." + name)
 
 

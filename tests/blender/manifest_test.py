@@ -37,8 +37,10 @@ with zipfile.ZipFile(ARGS.zip) as archive:
     manifest = tomllib.loads(archive.read(manifest_name).decode("utf-8"))
     check(manifest_name == "dqjulia/blender_manifest.toml", "the manifest is %s" % manifest_name)
     check(manifest["platforms"] == ["linux-x64"], "platforms lists only the verified one: %s" % manifest["platforms"])
-    check(all(len(reason) <= 64 for reason in manifest.get("permissions", {}).values()),
-          "every permission reason is at most 64 characters")
+    check(
+        all(len(reason) <= 64 for reason in manifest.get("permissions", {}).values()),
+        "every permission reason is at most 64 characters",
+    )
     check(archive.getinfo("dqjulia/lib/libdqjulia.so").file_size > 0, "the zip carries lib/libdqjulia.so")
     check(not [n for n in archive.namelist() if "__pycache__" in n or n.endswith(".pyc")], "and no bytecode")
 

@@ -55,31 +55,44 @@ RESULTS = {}
 # -------------------------------------------------------------------------------------------
 # helpers
 
+
 def look_at(eye, target, up):
     from mathutils import Matrix, Vector
+
     eye, target, up = Vector(eye), Vector(target), Vector(up)
     forward = (target - eye).normalized()
     right = forward.cross(up).normalized()
     true_up = right.cross(forward)
-    return Matrix(((right.x, right.y, right.z, -right.dot(eye)),
-                   (true_up.x, true_up.y, true_up.z, -true_up.dot(eye)),
-                   (-forward.x, -forward.y, -forward.z, forward.dot(eye)),
-                   (0.0, 0.0, 0.0, 1.0)))
+    return Matrix(
+        (
+            (right.x, right.y, right.z, -right.dot(eye)),
+            (true_up.x, true_up.y, true_up.z, -true_up.dot(eye)),
+            (-forward.x, -forward.y, -forward.z, forward.dot(eye)),
+            (0.0, 0.0, 0.0, 1.0),
+        )
+    )
 
 
 def perspective(fov_degrees, aspect, near, far):
     import math
     from mathutils import Matrix
+
     f = 1.0 / math.tan(math.radians(fov_degrees) / 2.0)
-    return Matrix(((f / aspect, 0.0, 0.0, 0.0), (0.0, f, 0.0, 0.0),
-                   (0.0, 0.0, (far + near) / (near - far), 2.0 * far * near / (near - far)),
-                   (0.0, 0.0, -1.0, 0.0)))
+    return Matrix(
+        (
+            (f / aspect, 0.0, 0.0, 0.0),
+            (0.0, f, 0.0, 0.0),
+            (0.0, 0.0, (far + near) / (near - far), 2.0 * far * near / (near - far)),
+            (0.0, 0.0, -1.0, 0.0),
+        )
+    )
 
 
 def offscreen_preview(obj, view, projection, width, height):
     """The preview drawn offscreen: (RGBA floats bottom-up, coverage mask top-down). Half floats,
     so the linear colour is not rounded to 8 bits."""
     import gpu
+
     try:
         offscreen = gpu.types.GPUOffScreen(width, height, format="RGBA16F")
     except (TypeError, ValueError):
@@ -111,7 +124,7 @@ def save_mask(path, mask, width, height):
         row, column = divmod(index, width)
         base = 4 * ((height - 1 - row) * width + column)
         value = 1.0 if inside else 0.0
-        pixels[base:base + 4] = array.array("f", [value, value, value, 1.0])
+        pixels[base : base + 4] = array.array("f", [value, value, value, 1.0])
     image.pixels.foreach_set(pixels)
     image.filepath_raw = path
     image.file_format = "PNG"
@@ -157,8 +170,17 @@ def cli_mask(document, width, height):
     if not ARGS.cli or not os.path.isfile(ARGS.cli):
         return None
     flat = json.loads(json.dumps(document))
-    flat["material"].update({"coloring": "solid", "color": [1.0, 1.0, 1.0], "ambient": 1.0, "diffuse": 0.0,
-                             "specular": 0.0, "occlusion": 0.0, "shadows": False})
+    flat["material"].update(
+        {
+            "coloring": "solid",
+            "color": [1.0, 1.0, 1.0],
+            "ambient": 1.0,
+            "diffuse": 0.0,
+            "specular": 0.0,
+            "occlusion": 0.0,
+            "shadows": False,
+        }
+    )
     flat["render"]["background"] = [0.0, 0.0, 0.0]
     params = os.path.join(ARGS.work, "cli_params.json")
     output = os.path.join(ARGS.work, "cli_render_%d.png" % len(os.listdir(ARGS.work)))
@@ -207,6 +229,7 @@ def screenshot(path):
 # -------------------------------------------------------------------------------------------
 # the steps, run from a timer once the window is up
 
+
 def setup_scene():
     for obj in list(bpy.data.objects):
         bpy.data.objects.remove(obj)
@@ -222,9 +245,17 @@ def setup_scene():
 def step_offscreen_iou(obj):
     cases = [
         ("default (paper, N=15, trap colouring)", {}),
-        ("dual, N=30, turned slice, iterations colouring",
-         {"variant": "dual", "iterations": 30, "c_a": (-0.2, 0.6, 0.2, 0.0), "c_b": (0.0, 0.0, 0.0, 0.0),
-          "rotation": ("a.j", "a.k", 35.0), "coloring": "iterations"}),
+        (
+            "dual, N=30, turned slice, iterations colouring",
+            {
+                "variant": "dual",
+                "iterations": 30,
+                "c_a": (-0.2, 0.6, 0.2, 0.0),
+                "c_b": (0.0, 0.0, 0.0, 0.0),
+                "rotation": ("a.j", "a.k", 35.0),
+                "coloring": "iterations",
+            },
+        ),
     ]
     s = obj.dqjulia
     for name, change in cases:
@@ -255,15 +286,19 @@ def step_offscreen_iou(obj):
         value = common.iou(drawn, expected)
         RESULTS["iou " + name] = value
         check(sum(expected) > 0.05 * WIDTH * HEIGHT, "%s: the core render covers %d pixels" % (name, sum(expected)))
-        check(value >= ARGS.min_iou, "%s: preview vs core render silhouette IoU %.4f (>= %.2f)"
-              % (name, value, ARGS.min_iou))
+        check(
+            value >= ARGS.min_iou,
+            "%s: preview vs core render silhouette IoU %.4f (>= %.2f)" % (name, value, ARGS.min_iou),
+        )
         preview_mean, core_mean, both = mean_colours(rgba, core_pixels, drawn, expected, WIDTH, HEIGHT)
         difference = max(abs(a - b) for a, b in zip(preview_mean, core_mean))
         RESULTS["colour difference " + name] = difference
-        check(both > 0.05 * WIDTH * HEIGHT and difference <= ARGS.max_colour_difference,
-              "%s: mean colour over %d pixels, preview (%.4f, %.4f, %.4f) vs core (%.4f, %.4f, %.4f): largest "
-              "channel difference %.4f (<= %.3f)" % ((name, both) + tuple(preview_mean) + tuple(core_mean)
-                                                   + (difference, ARGS.max_colour_difference)))
+        check(
+            both > 0.05 * WIDTH * HEIGHT and difference <= ARGS.max_colour_difference,
+            "%s: mean colour over %d pixels, preview (%.4f, %.4f, %.4f) vs core (%.4f, %.4f, %.4f): largest "
+            "channel difference %.4f (<= %.3f)"
+            % ((name, both) + tuple(preview_mean) + tuple(core_mean) + (difference, ARGS.max_colour_difference)),
+        )
         slug = name.split(" ")[0].strip(",")
         save_mask(os.path.join(ARGS.work, "mask_preview_%s.png" % slug), drawn, WIDTH, HEIGHT)
         save_mask(os.path.join(ARGS.work, "mask_core_%s.png" % slug), expected, WIDTH, HEIGHT)
@@ -288,8 +323,18 @@ def step_viewport(obj):
     # costs most of a second of the main thread, which would hide what the bake test measures.
     bpy.context.scene.display.viewport_aa = "OFF"
     overlay = space.overlay
-    for name in ("show_floor", "show_axis_x", "show_axis_y", "show_axis_z", "show_extras", "show_cursor",
-                 "show_text", "show_stats", "show_outline_selected", "show_object_origins"):
+    for name in (
+        "show_floor",
+        "show_axis_x",
+        "show_axis_y",
+        "show_axis_z",
+        "show_extras",
+        "show_cursor",
+        "show_text",
+        "show_stats",
+        "show_outline_selected",
+        "show_object_origins",
+    ):
         if hasattr(overlay, name):
             setattr(overlay, name, False)
     space.show_region_toolbar = False
@@ -305,8 +350,10 @@ def step_viewport(obj):
     obj.dqjulia.show_preview = True
     redraw()
     _width, _height, after = screenshot(os.path.join(ARGS.work, "viewport_on.png"))
-    check(preview.draw_count > count, "the draw handler drew the preview in the viewport (%d draws)"
-          % (preview.draw_count - count))
+    check(
+        preview.draw_count > count,
+        "the draw handler drew the preview in the viewport (%d draws)" % (preview.draw_count - count),
+    )
     changed = []
     for row in range(region.height - 1, -1, -1):
         y = region.y + row
@@ -315,8 +362,7 @@ def step_viewport(obj):
             base = 4 * (y * width + x)
             difference = max(abs(after[base + k] - before[base + k]) for k in range(3))
             changed.append(difference > 0.02)
-    _drew, _rgba, expected = offscreen_preview(obj, rv3d.view_matrix, rv3d.window_matrix, region.width,
-                                               region.height)
+    _drew, _rgba, expected = offscreen_preview(obj, rv3d.view_matrix, rv3d.window_matrix, region.width, region.height)
     value = common.iou(changed, expected)
     RESULTS["iou viewport"] = value
     check(sum(expected) > 1000, "the preview covers %d viewport pixels" % sum(expected))
@@ -328,6 +374,7 @@ def _show_sidebar_tab(area):
     active tab): click down the strip of tabs at the sidebar's right edge until our panel
     draws. Generator: yields to let Blender handle the clicks."""
     import dqjulia.panels as panels
+
     window = bpy.context.window_manager.windows[0]
     sidebar = next(region for region in area.regions if region.type == "UI")
     x = sidebar.x + sidebar.width - 9
@@ -355,8 +402,14 @@ def save_screenshots(obj):
     bpy.context.scene.display.viewport_aa = "8"
     bpy.context.scene.view_settings.view_transform = "Standard"  # the colours the CLI writes
     overlay = space.overlay
-    for name in ("show_floor", "show_axis_x", "show_axis_y", "show_extras", "show_outline_selected",
-                 "show_object_origins"):
+    for name in (
+        "show_floor",
+        "show_axis_x",
+        "show_axis_y",
+        "show_extras",
+        "show_outline_selected",
+        "show_object_origins",
+    ):
         setattr(overlay, name, True)
     space.show_region_ui = True
     with native.Context() as context:
@@ -435,8 +488,9 @@ class Bake:
     def start(self):
         self.obj.dqjulia.bake_resolution = self.resolution
         window, area, region = window_area_region()
-        with bpy.context.temp_override(window=window, area=area, region=region, active_object=self.obj,
-                                       object=self.obj):
+        with bpy.context.temp_override(
+            window=window, area=area, region=region, active_object=self.obj, object=self.obj
+        ):
             result = bpy.ops.dqjulia.bake_volume("INVOKE_DEFAULT")
         check(result == {"RUNNING_MODAL"}, "Bake Volume runs modal (%s)" % result)
         self.started = time.monotonic()
@@ -497,21 +551,28 @@ def run_steps():
             yield 0.05
         seconds = time.monotonic() - bake.started
         waited = time.monotonic()
-        while not any(child.get("dqjulia_bake") == "volume" for child in obj.children) \
-                and time.monotonic() - waited < 5.0:
+        while (
+            not any(child.get("dqjulia_bake") == "volume" for child in obj.children) and time.monotonic() - waited < 5.0
+        ):
             yield 0.1  # the operator builds the object at its next timer event
-        report("during the bake the viewport drew the preview %d times, marching it %d times (else from its cache)"
-               % (preview.draw_count - draws, preview.render_count - marches))
+        report(
+            "during the bake the viewport drew the preview %d times, marching it %d times (else from its cache)"
+            % (preview.draw_count - draws, preview.render_count - marches)
+        )
         volume = next((child for child in obj.children if child.get("dqjulia_bake") == "volume"), None)
         check(volume is not None and volume.type == "VOLUME", "the modal bake added a Volume object")
         # Frozen would mean one gap as long as the bake. A viewport redraw under llvmpipe, or
         # loading the VDB when the bake ends, takes a few tenths of a second on the main thread,
         # so the gap is compared with the bake's length rather than with a fixed time.
-        check(bake.ticks >= max(5, 0.3 * seconds / 0.05) and bake.longest_gap < seconds / 3,
-              "Blender ran its 0.05 s timer %d times during the %.1f s bake, at most %.2f s apart (not frozen)"
-              % (bake.ticks, seconds, bake.longest_gap))
-        check(len(set(round(f, 3) for f in bake.fractions)) >= 2,
-              "progress was reported (%d distinct values)" % len(set(round(f, 3) for f in bake.fractions)))
+        check(
+            bake.ticks >= max(5, 0.3 * seconds / 0.05) and bake.longest_gap < seconds / 3,
+            "Blender ran its 0.05 s timer %d times during the %.1f s bake, at most %.2f s apart (not frozen)"
+            % (bake.ticks, seconds, bake.longest_gap),
+        )
+        check(
+            len(set(round(f, 3) for f in bake.fractions)) >= 2,
+            "progress was reported (%d distinct values)" % len(set(round(f, 3) for f in bake.fractions)),
+        )
         if volume is not None:
             volume.data.grids.load()
             check("density" in [grid.name for grid in volume.data.grids], "its grids include density")
@@ -532,8 +593,10 @@ def run_steps():
             check(job.state == jobs.Job.CANCELLED, "the bake's state is %s" % job.state)
             report("the worker stopped %.2f s after Esc" % (job.finished - cancel.cancel_time))
         check(set(bpy.data.objects.keys()) == objects_before, "a cancelled bake adds no object")
-        check(set(Bake._files()) == files_before, "a cancelled bake leaves no file (%s)"
-              % sorted(set(Bake._files()) - files_before))
+        check(
+            set(Bake._files()) == files_before,
+            "a cancelled bake leaves no file (%s)" % sorted(set(Bake._files()) - files_before),
+        )
     else:
         check(False, "the library can bake (dqj_bake_vdb)")
 

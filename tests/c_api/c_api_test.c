@@ -16,15 +16,15 @@
 static int failures = 0;
 static int checks = 0;
 
-#define CHECK(condition, ...)                                     \
-    do {                                                          \
-        ++checks;                                                 \
-        if (!(condition)) {                                       \
-            ++failures;                                           \
+#define CHECK(condition, ...)                                       \
+    do {                                                            \
+        ++checks;                                                   \
+        if (!(condition)) {                                         \
+            ++failures;                                             \
             fprintf(stderr, "%s:%d: FAILED: ", __FILE__, __LINE__); \
-            fprintf(stderr, __VA_ARGS__);                         \
-            fprintf(stderr, "\n");                                \
-        }                                                         \
+            fprintf(stderr, __VA_ARGS__);                           \
+            fprintf(stderr, "\n");                                  \
+        }                                                           \
     } while (0)
 
 static int close_to(double actual, double expected) {
@@ -50,8 +50,8 @@ static int cancel_at_once(double fraction, void* user_data) {
 }
 
 static void test_versions(void) {
-    CHECK(dqj_version_number() == DQJ_VERSION_NUMBER, "run-time version %u differs from header %d", dqj_version_number(),
-          DQJ_VERSION_NUMBER);
+    CHECK(dqj_version_number() == DQJ_VERSION_NUMBER, "run-time version %u differs from header %d",
+          dqj_version_number(), DQJ_VERSION_NUMBER);
     CHECK(strlen(dqj_version_string()) >= 5, "version string too short");
     CHECK(strcmp(dqj_status_string(DQJ_ERROR_INVALID_HANDLE), "invalid handle") == 0, "status text");
 }
@@ -121,7 +121,8 @@ static void test_reference_values(dqj_context context) {
     dqj_sample out[2];
     CHECK(dqj_context_set_params_json(context, c1_paper) == DQJ_OK, "set params: %s", dqj_context_error(context));
     CHECK(dqj_evaluate_points(context, points, 2, out) == DQJ_OK, "evaluate: %s", dqj_context_error(context));
-    CHECK(out[0].n == 6 && close_to(out[0].r, 7.214903863267726) && close_to(out[0].ra, 0.8260141247850684) && isinf(out[0].de),
+    CHECK(out[0].n == 6 && close_to(out[0].r, 7.214903863267726) && close_to(out[0].ra, 0.8260141247850684) &&
+              isinf(out[0].de),
           "c1 point 1 paper: n=%d r=%.17g de=%g", out[0].n, out[0].r, out[0].de);
     CHECK(out[1].n == 6 && isinf(out[1].de), "c1 point 0 paper: n=%d", out[1].n);
 
@@ -154,15 +155,18 @@ static void test_errors(dqj_context context) {
     CHECK(strstr(dqj_context_error(context), "fractal.iterations") != NULL, "message names the key: %s",
           dqj_context_error(context));
     CHECK(dqj_context_set_bailout(context, 1.2) == DQJ_ERROR_PARAMETERS, "bailout below r_K accepted");
-    CHECK(strstr(dqj_context_error(context), "containment radius") != NULL, "bailout message: %s", dqj_context_error(context));
+    CHECK(strstr(dqj_context_error(context), "containment radius") != NULL, "bailout message: %s",
+          dqj_context_error(context));
     CHECK(dqj_context_set_slice_axes(context, "a.s,a.s,a.j") == DQJ_ERROR_INVALID_ARGUMENT, "repeated axis accepted");
-    CHECK(dqj_context_set_params_json(context, "{\"fractal\": {\"iteratons\": 5}}") == DQJ_ERROR_PARAMETERS, "typo accepted");
+    CHECK(dqj_context_set_params_json(context, "{\"fractal\": {\"iteratons\": 5}}") == DQJ_ERROR_PARAMETERS,
+          "typo accepted");
     CHECK(strstr(dqj_context_error(context), "did you mean \"iterations\"") != NULL, "no suggestion: %s",
           dqj_context_error(context));
     CHECK(dqj_context_set_params_json(context, "{\"fractal\": ") == DQJ_ERROR_PARAMETERS, "bad JSON accepted");
     CHECK(strstr(dqj_context_error(context), "line 1") != NULL, "no line number: %s", dqj_context_error(context));
     CHECK(dqj_evaluate_points(context, NULL, 1, out) == DQJ_ERROR_INVALID_ARGUMENT, "NULL points accepted");
-    CHECK(dqj_context_get_params_json(context, small, sizeof small, &needed) == DQJ_ERROR_INVALID_ARGUMENT, "small buffer");
+    CHECK(dqj_context_get_params_json(context, small, sizeof small, &needed) == DQJ_ERROR_INVALID_ARGUMENT,
+          "small buffer");
     CHECK(needed > 100, "size query gave %zu", needed);
 
     /* Handles: null, destroyed and garbage handles are rejected, not dereferenced. */
@@ -172,7 +176,8 @@ static void test_errors(dqj_context context) {
     CHECK(dqj_evaluate_points(other, point, 1, out) == DQJ_ERROR_INVALID_HANDLE, "destroyed handle accepted");
     CHECK(dqj_context_error(other)[0] != '\0', "no message for a destroyed handle");
     dqj_context_destroy(other); /* twice: ignored */
-    CHECK(dqj_evaluate_points((dqj_context)(void*)&needed, point, 1, out) == DQJ_ERROR_INVALID_HANDLE, "garbage handle");
+    CHECK(dqj_evaluate_points((dqj_context)(void*)&needed, point, 1, out) == DQJ_ERROR_INVALID_HANDLE,
+          "garbage handle");
     CHECK(dqj_context_create(NULL) == DQJ_ERROR_INVALID_ARGUMENT, "create(NULL)");
 
     /* A failed call leaves the previous parameters in place. */
@@ -204,12 +209,15 @@ static void test_render(dqj_context context, const char* scratch_dir) {
     CHECK(pixels[3] == 0, "corner pixel covered");
     CHECK(calls >= 1, "progress never called");
     CHECK(dqj_context_warning(context)[0] == '\0', "warning for a non-empty render: %s", dqj_context_warning(context));
-    CHECK(dqj_render_rgba8(context, pixels, W, H, W * 4, cancel_at_once, NULL) == DQJ_ERROR_CANCELLED, "cancel ignored");
-    CHECK(dqj_render_rgba8(context, pixels, W, H, W * 2, NULL, NULL) == DQJ_ERROR_INVALID_ARGUMENT, "short stride accepted");
+    CHECK(dqj_render_rgba8(context, pixels, W, H, W * 4, cancel_at_once, NULL) == DQJ_ERROR_CANCELLED,
+          "cancel ignored");
+    CHECK(dqj_render_rgba8(context, pixels, W, H, W * 2, NULL, NULL) == DQJ_ERROR_INVALID_ARGUMENT,
+          "short stride accepted");
 
     /* Writing into a folder that does not exist fails cleanly and leaves nothing behind. */
     snprintf(path, sizeof path, "%s/no-such-folder/x.png", scratch_dir);
-    CHECK(dqj_render_to_file(context, path, NULL, NULL) == DQJ_ERROR_IO, "missing folder: %s", dqj_context_error(context));
+    CHECK(dqj_render_to_file(context, path, NULL, NULL) == DQJ_ERROR_IO, "missing folder: %s",
+          dqj_context_error(context));
     file = fopen(path, "rb");
     CHECK(file == NULL, "a file appeared");
     if (file) fclose(file);

@@ -48,17 +48,22 @@ def main():
         context.mesh_compute()
         vertices, triangles = context.mesh_sizes()
         context.mesh_write(ply)
-    print(json.dumps({
-        "version": native.version()[1],
-        "library": native.library_path(),
-        "vdb_bytes": os.path.getsize(vdb),
-        "active_voxels": bake.active_voxels,
-        "voxels_evaluated": bake.voxels_evaluated,
-        "mesh_vertices": vertices,
-        "mesh_triangles": triangles,
-        "ply_bytes": os.path.getsize(ply),
-        "error_message": rejected,
-    }, sort_keys=True))
+    print(
+        json.dumps(
+            {
+                "version": native.version()[1],
+                "library": native.library_path(),
+                "vdb_bytes": os.path.getsize(vdb),
+                "active_voxels": bake.active_voxels,
+                "voxels_evaluated": bake.voxels_evaluated,
+                "mesh_vertices": vertices,
+                "mesh_triangles": triangles,
+                "ply_bytes": os.path.getsize(ply),
+                "error_message": rejected,
+            },
+            sort_keys=True,
+        )
+    )
     return 0
 
 

@@ -11,8 +11,7 @@ import subprocess
 import sys
 
 # glibc's own libraries: present on every glibc-based Linux.
-ALLOWED_NEEDED = {"libc.so.6", "libm.so.6", "libpthread.so.0", "libdl.so.2", "librt.so.1",
-                  "ld-linux-x86-64.so.2"}
+ALLOWED_NEEDED = {"libc.so.6", "libm.so.6", "libpthread.so.0", "libdl.so.2", "librt.so.1", "ld-linux-x86-64.so.2"}
 
 
 def run(*command):
@@ -54,7 +53,9 @@ def main():
     print("highest GLIBC_ version: %s (%s)" % (highest, ", ".join(sorted(versions.get(highest, [])))[:200]))
     for version, names in versions.items():
         if version_key(version) > version_key(args.glibc_floor):
-            failures.append("needs GLIBC_%s (above the floor %s) for %s" % (version, args.glibc_floor, ", ".join(names)))
+            failures.append(
+                "needs GLIBC_%s (above the floor %s) for %s" % (version, args.glibc_floor, ", ".join(names))
+            )
 
     strays = [name for name in exported if not name.startswith("dqj_")]
     print("exported symbols: %d (dqj_*), %d others" % (len(exported) - len(strays), len(strays)))

@@ -37,7 +37,8 @@ def mirror():
 
 def clean_root():
     cache = os.environ.get("DQJ_CLEANROOM_CACHE") or os.path.join(
-        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "dqjulia", "cleanroom")
+        os.environ.get("XDG_CACHE_HOME") or os.path.expanduser("~/.cache"), "dqjulia", "cleanroom"
+    )
     root = os.path.join(cache, SUITE + "-minbase-python3")
     if os.path.isfile(os.path.join(root, ".complete")):
         return root
@@ -45,8 +46,11 @@ def clean_root():
     partial = root + ".partial"
     shutil.rmtree(partial, ignore_errors=True)
     print("making the clean root %s (debootstrap --variant=minbase)" % root, flush=True)
-    subprocess.run(["debootstrap", "--variant=minbase", "--include=python3", SUITE, partial, mirror()],
-                   check=True, stdout=subprocess.DEVNULL)
+    subprocess.run(
+        ["debootstrap", "--variant=minbase", "--include=python3", SUITE, partial, mirror()],
+        check=True,
+        stdout=subprocess.DEVNULL,
+    )
     open(os.path.join(partial, ".complete"), "w").close()
     shutil.rmtree(root, ignore_errors=True)
     os.rename(partial, root)
@@ -74,10 +78,15 @@ def main():
     # The root really lacks the build's dependencies. (It has libstdc++ and zlib, which apt
     # needs; check_library.py shows the library does not use them.)
     system_libs = os.path.join(root, "usr/lib/x86_64-linux-gnu")
-    present = [name for name in os.listdir(system_libs)
-               if re.match(r"lib(openvdb|tbb|OpenEXR|Imath|png16|hwy|boost|freetype)", name)]
-    checks = {"the clean root has no OpenVDB, TBB, OpenEXR, Imath, libpng, Highway, Boost or FreeType%s"
-              % (" (found %s)" % ", ".join(present) if present else ""): not present}
+    present = [
+        name
+        for name in os.listdir(system_libs)
+        if re.match(r"lib(openvdb|tbb|OpenEXR|Imath|png16|hwy|boost|freetype)", name)
+    ]
+    checks = {
+        "the clean root has no OpenVDB, TBB, OpenEXR, Imath, libpng, Highway, Boost or FreeType%s"
+        % (" (found %s)" % ", ".join(present) if present else ""): not present
+    }
 
     inside = os.path.join(root, "tmp", "dqjulia-cleanroom")
     shutil.rmtree(inside, ignore_errors=True)
@@ -86,10 +95,24 @@ def main():
         archive.extractall(inside)
     os.chmod(os.path.join(inside, "dqjulia", "lib", "libdqjulia.so"), 0o755)
     shutil.copy(os.path.join(HERE, "bake_with_native.py"), inside)
-    clean = bake(["chroot", root, "/usr/bin/python3", "/tmp/dqjulia-cleanroom/bake_with_native.py",
-                  "/tmp/dqjulia-cleanroom/dqjulia", "/tmp/dqjulia-cleanroom/work"])
-    host = bake([sys.executable, os.path.join(HERE, "bake_with_native.py"), os.path.join(inside, "dqjulia"),
-                 os.path.join(work, "host")])
+    clean = bake(
+        [
+            "chroot",
+            root,
+            "/usr/bin/python3",
+            "/tmp/dqjulia-cleanroom/bake_with_native.py",
+            "/tmp/dqjulia-cleanroom/dqjulia",
+            "/tmp/dqjulia-cleanroom/work",
+        ]
+    )
+    host = bake(
+        [
+            sys.executable,
+            os.path.join(HERE, "bake_with_native.py"),
+            os.path.join(inside, "dqjulia"),
+            os.path.join(work, "host"),
+        ]
+    )
     shutil.rmtree(inside, ignore_errors=True)
 
     print("clean root: %s" % json.dumps(clean, sort_keys=True))
@@ -98,7 +121,8 @@ def main():
         checks["%s equal (%s)" % (key, clean[key])] = clean[key] == host[key] and clean[key] > 0
     checks["library version %s" % clean["version"]] = clean["version"] == host["version"]
     checks["errors explained (%s)" % clean["error_message"]] = (
-        clean["error_message"] == host["error_message"] and "iterations" in clean["error_message"])
+        clean["error_message"] == host["error_message"] and "iterations" in clean["error_message"]
+    )
     failed = [name for name, ok in checks.items() if not ok]
     for name, ok in checks.items():
         print("%s: %s" % ("ok" if ok else "FAIL", name))

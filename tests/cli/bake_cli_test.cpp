@@ -151,6 +151,8 @@ TEST_P(BakeInterrupt, StopsPromptlyAndKeepsThePreviousFile) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Signals, BakeInterrupt, ::testing::Values(SIGINT, SIGTERM),
-                         [](const ::testing::TestParamInfo<int>& info) { return info.param == SIGINT ? "SIGINT" : "SIGTERM"; });
+                         [](const ::testing::TestParamInfo<int>& info) {
+                             return info.param == SIGINT ? "SIGINT" : "SIGTERM";
+                         });
 
 }  // namespace

@@ -118,32 +118,36 @@ TEST_F(Cli, RenderWritesAPictureOfTheDefaultFractal) {
     // The fractal covers the middle of the frame and differs from the background there.
     const float* centre = &image.rgba[(60 * 160 + 80) * 4];
     const float* corner = &image.rgba[0];
-    EXPECT_GT(std::abs(centre[0] - corner[0]) + std::abs(centre[1] - corner[1]) + std::abs(centre[2] - corner[2]), 0.05f);
+    EXPECT_GT(std::abs(centre[0] - corner[0]) + std::abs(centre[1] - corner[1]) + std::abs(centre[2] - corner[2]),
+              0.05f);
 }
 
 TEST_F(Cli, RenderOfAnEmptySliceSaysWhy) {
     const std::string out = path("empty.png");
-    const Outcome result = run("render -q -W 32 -H 24 --c -0.10 0.8 -0.26 0.15 -0.23 -0.38 -0.86 0.64 --variant paper -o '" + out + "'");
+    const Outcome result =
+        run("render -q -W 32 -H 24 --c -0.10 0.8 -0.26 0.15 -0.23 -0.38 -0.86 0.64 --variant paper -o '" + out + "'");
     EXPECT_EQ(result.exitCode, 0) << result.err;
     EXPECT_NE(result.err.find("no surface"), std::string::npos) << result.err;
     EXPECT_NE(result.err.find("outside the Mandelbrot set"), std::string::npos) << result.err;
 }
 
 TEST_F(Cli, ParameterFileAndFlagOverrides) {
-    const std::string file = write("p.json", R"({"fractal": {"iterations": 7, "variant": "dual"}, "render": {"width": 40, "height": 30}})");
+    const std::string file =
+        write("p.json", R"({"fractal": {"iterations": 7, "variant": "dual"}, "render": {"width": 40, "height": 30}})");
     const std::string saved = path("saved.json");
-    const Outcome result = run("render -q -p '" + file + "' -n 9 -o '" + path("o.png") + "' --save-params '" + saved + "'");
+    const Outcome result =
+        run("render -q -p '" + file + "' -n 9 -o '" + path("o.png") + "' --save-params '" + saved + "'");
     ASSERT_EQ(result.exitCode, 0) << result.err;
     const std::string text = readFile(saved);
-    EXPECT_NE(text.find("\"iterations\": 9"), std::string::npos) << text;   // flag wins
+    EXPECT_NE(text.find("\"iterations\": 9"), std::string::npos) << text;      // flag wins
     EXPECT_NE(text.find("\"variant\": \"dual\""), std::string::npos) << text;  // file kept
     EXPECT_EQ(dqj::readPng(path("o.png")).width, 40);
 }
 
 struct BadInput {
     std::string arguments;
-    std::string file;       // parameter file contents, if any (passed with -p)
-    std::string message;    // expected in stderr
+    std::string file;     // parameter file contents, if any (passed with -p)
+    std::string message;  // expected in stderr
 };
 
 TEST_F(Cli, BadInputGetsOneClearMessageAndWritesNothing) {
@@ -181,7 +185,8 @@ TEST_F(Cli, BadInputGetsOneClearMessageAndWritesNothing) {
 TEST_F(Cli, UnwritableOutputFailsBeforeWorkWithoutPartialFiles) {
     const Outcome result = run("render -q -W 16 -H 12 -o '" + path("missing/dir/x.png") + "'");
     EXPECT_EQ(result.exitCode, 2);
-    EXPECT_NE(result.err.find("the folder '" + path("missing/dir") + "' does not exist"), std::string::npos) << result.err;
+    EXPECT_NE(result.err.find("the folder '" + path("missing/dir") + "' does not exist"), std::string::npos)
+        << result.err;
     EXPECT_FALSE(fs::exists(path("missing")));
     // An existing image is left intact when a render into it fails validation.
     const std::string existing = write("keep.png", "precious");

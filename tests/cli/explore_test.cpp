@@ -32,8 +32,12 @@ fs::path scratch(const std::string& name) {
 
 TEST(Explore, SameSeedSameConstantsAndEveryTileIsNonEmpty) {
     const fs::path first = scratch("first"), second = scratch("second");
-    ASSERT_EQ(runCli("explore -q --seed 11 --count 4 --columns 2 --tile-width 64 --tile-height 48 -o '" + first.string() + "'"), 0);
-    ASSERT_EQ(runCli("explore -q --seed 11 --count 4 --columns 2 --tile-width 64 --tile-height 48 -o '" + second.string() + "'"), 0);
+    ASSERT_EQ(runCli("explore -q --seed 11 --count 4 --columns 2 --tile-width 64 --tile-height 48 -o '" +
+                     first.string() + "'"),
+              0);
+    ASSERT_EQ(runCli("explore -q --seed 11 --count 4 --columns 2 --tile-width 64 --tile-height 48 -o '" +
+                     second.string() + "'"),
+              0);
     for (int tile = 1; tile <= 4; ++tile) {
         const std::string name = "tile_0" + std::to_string(tile);
         const std::string json = readFile(first / (name + ".json"));
@@ -52,7 +56,8 @@ TEST(Explore, SameSeedSameConstantsAndEveryTileIsNonEmpty) {
     // A different seed gives different constants.
     const fs::path other = scratch("other");
     ASSERT_EQ(runCli("explore -q --seed 12 --count 1 --tile-width 32 --tile-height 24 -o '" + other.string() + "'"), 0);
-    EXPECT_NE(dqj::parseParams(readFile(other / "tile_01.json")).fractal.c.a, dqj::parseParams(readFile(first / "tile_01.json")).fractal.c.a);
+    EXPECT_NE(dqj::parseParams(readFile(other / "tile_01.json")).fractal.c.a,
+              dqj::parseParams(readFile(first / "tile_01.json")).fractal.c.a);
     // Two columns of 64 px plus padding; the sheet exists once and is refused the second time.
     const dqj::Image sheet = dqj::readPng((first / "sheet.png").string());
     EXPECT_EQ(sheet.width, 8 + 2 * (64 + 8));
@@ -71,7 +76,8 @@ TEST(ContactSheet, LaysOutTilesAndDrawsLabels) {
     };
     dqj::SheetLayout layout;
     layout.columns = 2;
-    const dqj::Image sheet = dqj::composeSheet({{tile(1.0f), "first"}, {tile(0.5f), "second\nline"}, {tile(0.25f), ""}}, layout);
+    const dqj::Image sheet =
+        dqj::composeSheet({{tile(1.0f), "first"}, {tile(0.5f), "second\nline"}, {tile(0.25f), ""}}, layout);
     const int labelHeight = layout.labelLines * (layout.fontPixels + layout.fontPixels / 3) + layout.padding / 2;
     EXPECT_EQ(sheet.width, 8 + 2 * (40 + 8));
     EXPECT_EQ(sheet.height, 8 + 2 * (30 + labelHeight + 8));

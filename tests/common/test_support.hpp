@@ -114,7 +114,8 @@ inline pid_t spawnProgram(const std::string& program, const std::vector<std::str
 /// The names of the files in a folder, sorted.
 inline std::vector<std::string> fileNames(const std::filesystem::path& folder) {
     std::vector<std::string> names;
-    for (const auto& entry : std::filesystem::directory_iterator(folder)) names.push_back(entry.path().filename().string());
+    for (const auto& entry : std::filesystem::directory_iterator(folder))
+        names.push_back(entry.path().filename().string());
     std::sort(names.begin(), names.end());
     return names;
 }

@@ -39,7 +39,8 @@ protected:
     fs::path dir_;
 };
 
-std::map<std::string, openvdb::GridBase::Ptr> readGrids(const std::string& path, openvdb::MetaMap::Ptr* metadata = nullptr) {
+std::map<std::string, openvdb::GridBase::Ptr> readGrids(const std::string& path,
+                                                        openvdb::MetaMap::Ptr* metadata = nullptr) {
     openvdb::io::File file(path);
     file.open();
     std::map<std::string, openvdb::GridBase::Ptr> grids;
@@ -196,7 +197,8 @@ TEST_F(Bake, TheMeshOfCZeroIsAClosedUnitSphere) {
     ASSERT_EQ(corners.size(), 3 * mesh.triangleCount());
     double volume = 0.0;
     for (std::size_t index = 0; index < corners.size(); index += 3) {
-        const glm::dvec3 a(mesh.positions[corners[index]]), b(mesh.positions[corners[index + 1]]), c(mesh.positions[corners[index + 2]]);
+        const glm::dvec3 a(mesh.positions[corners[index]]), b(mesh.positions[corners[index + 1]]),
+            c(mesh.positions[corners[index + 2]]);
         EXPECT_GT(glm::length(glm::cross(b - a, c - a)), 1e-6 * h * h);
         volume += glm::dot(a, glm::cross(b, c)) / 6.0;
     }
@@ -229,7 +231,8 @@ TEST_F(Bake, MeshFilesHoldTheMesh) {
     while (std::getline(ply, line) && line != "end_header") header += line + "\n";
     EXPECT_NE(header.find("format binary_little_endian 1.0"), std::string::npos);
     EXPECT_NE(header.find("element vertex " + std::to_string(mesh.positions.size())), std::string::npos);
-    EXPECT_NE(header.find("element face " + std::to_string(mesh.quads.size() + mesh.triangles.size())), std::string::npos);
+    EXPECT_NE(header.find("element face " + std::to_string(mesh.quads.size() + mesh.triangles.size())),
+              std::string::npos);
     EXPECT_NE(header.find("property uchar red"), std::string::npos);
     const std::streampos body = ply.tellg();
     ply.seekg(0, std::ios::end);
@@ -302,7 +305,8 @@ TEST(BallBound, EveryPointOfAProvenBallEscapesWithADeAboveTheBound) {
         fractal.bailout = minimumBailout(fractal) + 0.5;
         for (int trial = 0; trial < 300; ++trial) {
             DualQuat centre;
-            for (int index = 0; index < 8; ++index) component(centre, index) = 1.6 * unit(random) * (index < 4 ? 1.0 : 0.3);
+            for (int index = 0; index < 8; ++index)
+                component(centre, index) = 1.6 * unit(random) * (index < 4 ? 1.0 : 0.3);
             const double radius = 0.05 * (1 + trial % 4);
             const BallBound bound = boundBall(fractal, centre, radius, radius);
             if (!bound.allEscape) continue;
@@ -312,7 +316,8 @@ TEST(BallBound, EveryPointOfAProvenBallEscapesWithADeAboveTheBound) {
                 // A point of the ball (each part within the radius).
                 double a[4], b[4], na = 0, nb = 0;
                 for (int k = 0; k < 4; ++k) na += (a[k] = unit(random)) * a[k], nb += (b[k] = unit(random)) * b[k];
-                const double sa = radius * std::abs(unit(random)) / std::sqrt(na), sb = radius * std::abs(unit(random)) / std::sqrt(nb);
+                const double sa = radius * std::abs(unit(random)) / std::sqrt(na),
+                             sb = radius * std::abs(unit(random)) / std::sqrt(nb);
                 for (int k = 0; k < 4; ++k) component(q, k) += sa * a[k], component(q, 4 + k) += sb * b[k];
                 const Escape escape = evaluate(fractal, q);
                 ASSERT_NE(escape.n, 0) << variantName(variant);
@@ -336,7 +341,7 @@ TEST(Animation, KeyframesInterpolateLinearlyAndSmoothly) {
       }})");
     EXPECT_EQ(atFrame(params, -3).fractal.iterations, 10);  // before the first key: the first value
     EXPECT_EQ(atFrame(params, 6).fractal.iterations, 15);
-    EXPECT_EQ(atFrame(params, 6.4).fractal.iterations, 15);   // rounded
+    EXPECT_EQ(atFrame(params, 6.4).fractal.iterations, 15);  // rounded
     EXPECT_EQ(atFrame(params, 99).fractal.iterations, 20);
     EXPECT_NEAR(scalarPart(atFrame(params, 3).fractal.c.a), -0.29527, 1e-12);
     // Smooth: through the keys, flat at the ends, never overshooting, rising monotonically.
@@ -356,13 +361,15 @@ TEST(Animation, KeyframesInterpolateLinearlyAndSmoothly) {
 
 TEST(Animation, BadKeyframesAreRejectedWithTheKey) {
     const std::vector<std::pair<std::string, std::string>> cases = {
-        {R"({"animation": {"fractal.iterations": [{"frame": 5, "value": 10}, {"frame": 2, "value": 12}]}})", "frames must increase"},
+        {R"({"animation": {"fractal.iterations": [{"frame": 5, "value": 10}, {"frame": 2, "value": 12}]}})",
+         "frames must increase"},
         {R"({"animation": {"fractal.variant": [{"frame": 1, "value": 1}]}})", "cannot be animated"},
         {R"({"animation": {"fractal.iterations": [{"frame": 1, "value": 10.5}]}})", "whole number"},
         {R"({"animation": {"fractal.c": [{"frame": 1, "value": [1, 2]}]}})", "array of 8 numbers"},
         {R"({"animation": {"slice.rotations[2].degrees": [{"frame": 1, "value": 3}]}})", "slice.rotations has 0"},
         {R"({"animation": {"fractal.bailout": [{"frame": 1, "value": 1.2}]}})", "at frame 1"},
-        {R"({"animation": {"fractal.iterations": [{"frame": 1, "value": 10, "interpolation": "cubic"}]}})", "linear, smooth"},
+        {R"({"animation": {"fractal.iterations": [{"frame": 1, "value": 10, "interpolation": "cubic"}]}})",
+         "linear, smooth"},
         {R"({"animation": {"fractal.iterations": []}})", "non-empty array"},
     };
     for (const auto& [json, message] : cases) {
@@ -417,7 +424,8 @@ protected:
 
 TEST_F(BakeCApi, MeshIntoCallerBuffers) {
     ASSERT_EQ(dqj_context_set_params_json(context_, R"({"fractal": {"c": [0,0,0,0,0,0,0,0]},
-        "bake": {"bounds": {"min": [-1.5,-1.5,-1.5], "max": [1.5,1.5,1.5]}}})"), DQJ_OK);
+        "bake": {"bounds": {"min": [-1.5,-1.5,-1.5], "max": [1.5,1.5,1.5]}}})"),
+              DQJ_OK);
     ASSERT_EQ(dqj_context_set_bake_resolution(context_, 24), DQJ_OK);
     EXPECT_EQ(dqj_context_set_bake_resolution(context_, 3), DQJ_ERROR_PARAMETERS);
     EXPECT_NE(std::string(dqj_context_error(context_)).find("bake.resolution"), std::string::npos);
@@ -433,7 +441,9 @@ TEST_F(BakeCApi, MeshIntoCallerBuffers) {
     EXPECT_EQ(dqj_mesh_copy(context_, positions.data(), nullptr, nullptr, vertices - 1, indices.data(), triangles),
               DQJ_ERROR_INVALID_ARGUMENT);
     EXPECT_NE(std::string(dqj_context_error(context_)).find("too small"), std::string::npos);
-    ASSERT_EQ(dqj_mesh_copy(context_, positions.data(), normals.data(), colors.data(), vertices, indices.data(), triangles), DQJ_OK);
+    ASSERT_EQ(dqj_mesh_copy(context_, positions.data(), normals.data(), colors.data(), vertices, indices.data(),
+                            triangles),
+              DQJ_OK);
     dqj_bake_stats stats = DQJ_BAKE_STATS_INIT;
     ASSERT_EQ(dqj_bake_get_stats(context_, &stats), DQJ_OK);
     for (size_t index = 0; index < vertices; ++index) {
@@ -484,7 +494,8 @@ TEST_F(BakeCApi, BakeWithCancelMemoryLimitAndFrames) {
 
     // Keyframed iterations: frame 1 and frame 3 bake different surfaces.
     ASSERT_EQ(dqj_context_set_params_json(context_, R"({"bake": {"resolution": 32},
-        "animation": {"fractal.iterations": [{"frame": 1, "value": 4}, {"frame": 3, "value": 15}]}})"), DQJ_OK);
+        "animation": {"fractal.iterations": [{"frame": 1, "value": 4}, {"frame": 3, "value": 15}]}})"),
+              DQJ_OK);
     dqj_bake_stats first = DQJ_BAKE_STATS_INIT, third = DQJ_BAKE_STATS_INIT;
     ASSERT_EQ(dqj_context_set_frame(context_, 1), DQJ_OK);
     ASSERT_EQ(dqj_bake_vdb(context_, path("f1.vdb").c_str(), nullptr, nullptr), DQJ_OK);

@@ -94,7 +94,8 @@ std::vector<DualQuat> surfacePoints(const Fractal& fractal, std::size_t count, u
             (inside(middle) ? lo : hi) = middle;
         }
         const glm::dvec3 direction = out - in;
-        points.push_back(slice.map(lo + 1e-4 * uniform(random) / std::sqrt(glm::dot(direction, direction)) * direction));
+        points.push_back(
+            slice.map(lo + 1e-4 * uniform(random) / std::sqrt(glm::dot(direction, direction)) * direction));
     }
     return points;
 }
@@ -119,7 +120,9 @@ Results<T> runBatch(const Fractal& fractal, const std::vector<DualQuat>& points,
     PointBatch<T> batch;
     for (int k = 0; k < 8; ++k) batch.coords[k] = coords[k].data();
     batch.count = count;
-    evaluateBatch(fractal, batch, EscapeBatch<T>{out.n.data(), out.r.data(), out.ra.data(), out.rb.data(), out.de.data(), out.trap.data()},
+    evaluateBatch(fractal, batch,
+                  EscapeBatch<T>{out.n.data(), out.r.data(), out.ra.data(), out.rb.data(), out.de.data(),
+                                 out.trap.data()},
                   target);
     return out;
 }
@@ -169,7 +172,8 @@ private:
         deltaB_ = 2.0 * rb * deltaB_ + deltaB_ * deltaB_ + 8.0 * kUnit * (rb * rb + norm(fractal_.c.b));
         const Quat previous = a_;
         a_ = square(a_) + fractal_.c.a;
-        b_ = fractal_.variant == Variant::Dual ? symmetricProduct(previous, b_) + fractal_.c.b : square(b_) + fractal_.c.b;
+        b_ = fractal_.variant == Variant::Dual ? symmetricProduct(previous, b_) + fractal_.c.b
+                                               : square(b_) + fractal_.c.b;
         ++iteration_;
     }
 
@@ -235,11 +239,11 @@ TEST(BatchDouble, MatchesEvaluateOnEveryTarget) {
                                           sameDistance(want.de, got.de[i], 1e-12);
                         if (!same) {
                             ++failures;
-                            ADD_FAILURE() << target.name << " " << describe(fractal) << " point " << i << ": n "
-                                          << got.n[i] << " vs " << want.n << ", r " << got.r[i] << " vs " << want.r
-                                          << ", ra " << got.ra[i] << " vs " << want.ra << ", rb " << got.rb[i]
-                                          << " vs " << want.rb << ", trap " << got.trap[i] << " vs " << want.trap
-                                          << ", de " << got.de[i] << " vs " << want.de;
+                            ADD_FAILURE()
+                                << target.name << " " << describe(fractal) << " point " << i << ": n " << got.n[i]
+                                << " vs " << want.n << ", r " << got.r[i] << " vs " << want.r << ", ra " << got.ra[i]
+                                << " vs " << want.ra << ", rb " << got.rb[i] << " vs " << want.rb << ", trap "
+                                << got.trap[i] << " vs " << want.trap << ", de " << got.de[i] << " vs " << want.de;
                         }
                     }
                 }
@@ -283,7 +287,8 @@ TEST(BatchDouble, ExtremeStartsMatchIncludingInfinitiesAndNaN) {
                             same(got.trap[i], want.trap) &&
                             (same(got.de[i], want.de) || sameDistance(want.de, got.de[i], 1e-12)))
                     << target.name << " " << describe(fractal) << " x = " << values[i] << ": r " << got.r[i] << " vs "
-                    << want.r << ", de " << got.de[i] << " vs " << want.de << ", trap " << got.trap[i] << " vs " << want.trap;
+                    << want.r << ", de " << got.de[i] << " vs " << want.de << ", trap " << got.trap[i] << " vs "
+                    << want.trap;
             }
         }
     }
@@ -356,14 +361,16 @@ TEST(BatchFloat, EscapeCountsMatchExceptWithinRoundingOfTheBailout) {
 TEST(BatchFloat, NearTheSurfaceEveryMismatchIsWithinRounding) {
     for (const Variant variant : kVariants) {
         for (const int iterations : {12, 30}) {
-            const Fractal fractal = makeFractal(variant == Variant::Paper ? kC2 : kQuaternionJulia, variant, iterations);
+            const Fractal fractal =
+                makeFractal(variant == Variant::Paper ? kC2 : kQuaternionJulia, variant, iterations);
             const std::vector<DualQuat> points = surfacePoints(fractal, 50000, 6);
             for (const BatchTarget& target : {batchTargets().front(), batchTargets().back()}) {
                 const FloatCounts counts = compareFloat(fractal, points, target);
-                std::printf("%s float, %s, points within 1e-4 of the surface: %zu of %zu escape counts differ, %zu not "
-                            "near the bailout\n",
-                            target.name.c_str(), describe(fractal).c_str(), counts.mismatches, counts.total,
-                            counts.unexplained);
+                std::printf(
+                    "%s float, %s, points within 1e-4 of the surface: %zu of %zu escape counts differ, %zu not "
+                    "near the bailout\n",
+                    target.name.c_str(), describe(fractal).c_str(), counts.mismatches, counts.total,
+                    counts.unexplained);
                 EXPECT_EQ(counts.unexplained, 0u) << target.name << " " << describe(fractal);
             }
         }

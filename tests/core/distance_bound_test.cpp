@@ -40,11 +40,11 @@ using dqj::Fractal;
 using dqj::Slice;
 
 const dqj::DualQuat kC2{dqj::makeQuat(-0.39054, -0.58679, 0.0, 0.0), dqj::makeQuat(0.0, 0.5632, 0.0, 0.05)};
-constexpr int kGridSize = 160;          // grid points per axis
+constexpr int kGridSize = 160;  // grid points per axis
 constexpr int kClassifyIterations = 200;
-constexpr int kNearPoints = 600;        // outside points placed close to the set
-constexpr int kUniformPoints = 400;     // outside points anywhere within radius 3
-constexpr int kFarPoints = 100;         // per far radius
+constexpr int kNearPoints = 600;     // outside points placed close to the set
+constexpr int kUniformPoints = 400;  // outside points anywhere within radius 3
+constexpr int kFarPoints = 100;      // per far radius
 constexpr int kTestedIterations[] = {30, 40, 50};
 
 using dqj::test::Random;
@@ -185,9 +185,9 @@ void checkLowerBound(const BoundCase& test, std::uint64_t seed) {
             const double de = dqj::evaluate(fractal, test.slice.map(p)).de;
             if (de == 0.0) continue;  // in the shell between K_N and K_50: nothing to bound
             ++checks;
-            EXPECT_LE(de, distance[index] + tolerance) << "N=" << iterations << " point " << p.x << " " << p.y << " "
-                                                       << p.z << ": DE " << de << " exceeds the distance "
-                                                       << distance[index];
+            EXPECT_LE(de, distance[index] + tolerance)
+                << "N=" << iterations << " point " << p.x << " " << p.y << " " << p.z << ": DE " << de
+                << " exceeds the distance " << distance[index];
             const double ratio = distance[index] / de;
             minimumRatio = std::min(minimumRatio, ratio);
             if (glm::length(p - bounds->center) <= bounds->radius)

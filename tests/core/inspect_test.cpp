@@ -68,7 +68,8 @@ TEST(Inspect, SliceMissingTheContainmentBallIsEmptyForEveryN) {
 
 TEST(Inspect, DustIsExplained) {
     // A real part far outside the Mandelbrot set: dust, no sample inside.
-    const InspectReport report = inspect(withConstant({makeQuat(0.3, 0.9, 0.4, 0.0), makeQuat(0, 0, 0, 0)}, Variant::Dual, 20), 16);
+    const InspectReport report =
+        inspect(withConstant({makeQuat(0.3, 0.9, 0.4, 0.0), makeQuat(0, 0, 0, 0)}, Variant::Dual, 20), 16);
     EXPECT_FALSE(report.real.inMandelbrot);
     EXPECT_FALSE(report.emptyReason.empty());
     EXPECT_NE(report.emptyReason.find("dust"), std::string::npos) << report.emptyReason;

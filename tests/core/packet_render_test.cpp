@@ -20,9 +20,9 @@ namespace {
 
 struct Agreement {
     std::size_t pixels = 0;
-    std::size_t within = 0;         // every channel within 2/255 (8-bit sRGB, alpha linear)
-    std::size_t silhouette = 0;     // alpha > 0.5 in one and not the other
-    int worst = 0;                  // largest 8-bit difference
+    std::size_t within = 0;      // every channel within 2/255 (8-bit sRGB, alpha linear)
+    std::size_t silhouette = 0;  // alpha > 0.5 in one and not the other
+    int worst = 0;               // largest 8-bit difference
 };
 
 int code(float value, bool alpha) {
@@ -36,7 +36,8 @@ Agreement compare(const Image& packet, const Image& scalar) {
         int largest = 0;
         for (int channel = 0; channel < 4; ++channel) {
             const std::size_t at = 4 * pixel + channel;
-            largest = std::max(largest, std::abs(code(packet.rgba[at], channel == 3) - code(scalar.rgba[at], channel == 3)));
+            largest =
+                std::max(largest, std::abs(code(packet.rgba[at], channel == 3) - code(scalar.rgba[at], channel == 3)));
         }
         agreement.worst = std::max(agreement.worst, largest);
         if (largest <= 2) ++agreement.within;
@@ -51,14 +52,16 @@ void expectSamePicture(const Params& params, const std::string& what) {
     ASSERT_EQ(packet.image.width, scalar.image.width);
     ASSERT_EQ(packet.image.height, scalar.image.height);
     const Agreement agreement = compare(packet.image, scalar.image);
-    std::printf("%s: %zu of %zu pixels within 2/255, %zu silhouette differences, worst %d/255; packet %.3f s, scalar %.3f s\n",
-                what.c_str(), agreement.within, agreement.pixels, agreement.silhouette, agreement.worst,
-                packet.stats.seconds, scalar.stats.seconds);
+    std::printf(
+        "%s: %zu of %zu pixels within 2/255, %zu silhouette differences, worst %d/255; packet %.3f s, scalar %.3f s\n",
+        what.c_str(), agreement.within, agreement.pixels, agreement.silhouette, agreement.worst, packet.stats.seconds,
+        scalar.stats.seconds);
     EXPECT_GE(agreement.within, agreement.pixels * 995 / 1000) << what;
     EXPECT_LE(agreement.silhouette, agreement.pixels / 1000) << what;
     EXPECT_EQ(packet.stats.rays, scalar.stats.rays) << what;
     // Steps and hits may differ only where a last-bit difference in the DE flips a decision.
-    EXPECT_NEAR(static_cast<double>(packet.stats.steps), static_cast<double>(scalar.stats.steps), 1e-3 * scalar.stats.steps)
+    EXPECT_NEAR(static_cast<double>(packet.stats.steps), static_cast<double>(scalar.stats.steps),
+                1e-3 * scalar.stats.steps)
         << what;
     EXPECT_NEAR(static_cast<double>(packet.stats.hitPixels), static_cast<double>(scalar.stats.hitPixels),
                 1e-3 * agreement.pixels)

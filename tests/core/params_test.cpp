@@ -61,7 +61,8 @@ TEST(Params, RoundTripKeepsEveryValue) {
 }
 
 TEST(Params, FullSliceFormReadsAxisVectors) {
-    const Params params = parseParams(R"({"slice": {"axes": [[0.6,0.8,0,0,0,0,0,0],[-0.8,0.6,0,0,0,0,0,0],[0,0,0,0,1,0,0,0]]}})");
+    const Params params =
+        parseParams(R"({"slice": {"axes": [[0.6,0.8,0,0,0,0,0,0],[-0.8,0.6,0,0,0,0,0,0],[0,0,0,0,1,0,0,0]]}})");
     EXPECT_DOUBLE_EQ(params.slice.base.axes[0][1], 0.8);
     EXPECT_DOUBLE_EQ(params.slice.base.axes[2][4], 1.0);
     EXPECT_EQ(axisNamesOf(params.slice.base), "");
@@ -73,18 +74,22 @@ TEST(Params, EachBadValueNamesItsKey) {
         const char* expected;
     };
     const Case cases[] = {
-        {R"({"fractal": {"iterations": 0}})", "test.json: fractal.iterations: must be a whole number from 1 to 100000, got 0"},
+        {R"({"fractal": {"iterations": 0}})",
+         "test.json: fractal.iterations: must be a whole number from 1 to 100000, got 0"},
         {R"({"fractal": {"iterations": 2.5}})", "fractal.iterations: must be a whole number"},
-        {R"({"fractal": {"variant": "octonion"}})", "fractal.variant: must be one of paper, paper-coupled, dual, got \"octonion\""},
+        {R"({"fractal": {"variant": "octonion"}})",
+         "fractal.variant: must be one of paper, paper-coupled, dual, got \"octonion\""},
         {R"({"fractal": {"c": [1, 2]}})", "fractal.c: must be an array of 8 numbers"},
         {R"({"fractal": {"c": [0, 0, 0, 0, 0, 0, 0, "x"]}})", "fractal.c[7]: must be a number"},
-        {R"({"fractal": {"c": [0, 0, 0, 0, 0, 0, 0, 1e999]}})", "test.json: malformed JSON: number overflow parsing '1e999'"},
+        {R"({"fractal": {"c": [0, 0, 0, 0, 0, 0, 0, 1e999]}})",
+         "test.json: malformed JSON: number overflow parsing '1e999'"},
         {R"({"fractal": {"bailout": 1.2}})", "fractal.bailout: is 1.2 but must be at least the containment radius"},
         {R"({"fractal": {"iteratons": 3}})", "unknown key \"iteratons\"; did you mean \"iterations\"?"},
         {R"({"fractl": {}})", "did you mean \"fractal\"?"},
         {R"({"slice": {"axes": "a.s,a.i"}})", "slice.axes: a slice names exactly 3 axes"},
         {R"({"slice": {"rotations": [{"plane": "a.s,a.s", "degrees": 3}]}})", "slice.rotations[0].plane"},
-        {R"({"slice": {"axes": [[0,0,0,0,0,0,0,0],[0,1,0,0,0,0,0,0],[0,0,1,0,0,0,0,0]]}})", "slice.axes: the three axes are zero or parallel"},
+        {R"({"slice": {"axes": [[0,0,0,0,0,0,0,0],[0,1,0,0,0,0,0,0],[0,0,1,0,0,0,0,0]]}})",
+         "slice.axes: the three axes are zero or parallel"},
         {R"({"camera": {"fov": 0}})", "camera.fov"},
         {R"({"camera": {"position": [0, 0, 3], "target": [0, 0, 3]}})", "camera.position: equals camera.target"},
         {R"({"camera": {"up": [0, 0, 0]}})", "camera.up"},

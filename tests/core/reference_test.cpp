@@ -24,7 +24,7 @@ struct ReferenceRow {
     int line = 0;
     std::string constant;  // "c1" or "c2"
     std::string point;
-    std::string variant;   // "A", "A8" or "B"
+    std::string variant;  // "A", "A8" or "B"
     dqj::DualQuat start;
     int iterations = 0;
     double bailout = 0.0;

@@ -64,9 +64,7 @@ double encodeSrgb(double linear) {
 /// A fresh folder per test, removed afterwards.
 class TempFolder {
 public:
-    TempFolder() {
-        path_ = dqj::test::freshTestFolder("dqjulia_render_test");
-    }
+    TempFolder() { path_ = dqj::test::freshTestFolder("dqjulia_render_test"); }
     ~TempFolder() { fs::remove_all(path_); }
     const fs::path& path() const { return path_; }
     std::size_t entries() const { return std::distance(fs::directory_iterator(path_), fs::directory_iterator()); }
@@ -138,17 +136,18 @@ void checkBall(Variant variant, NormalMethod normals) {
         }
     }
     const int pixels = width * height;
-    EXPECT_LE(disagreements, pixels / 100) << disagreements << " of " << pixels << " pixels disagree with the exact silhouette";
+    EXPECT_LE(disagreements, pixels / 100)
+        << disagreements << " of " << pixels << " pixels disagree with the exact silhouette";
     EXPECT_EQ(interiorDisagreements, 0) << interiorDisagreements << " disagreeing pixels are not on the silhouette";
     EXPECT_GT(checkedNormals, pixels / 3);
-    EXPECT_EQ(badNormals, 0) << badNormals << " of " << checkedNormals << " normals off by more than 8 degrees; worst dot "
-                             << worstDot;
+    EXPECT_EQ(badNormals, 0) << badNormals << " of " << checkedNormals
+                             << " normals off by more than 8 degrees; worst dot " << worstDot;
     EXPECT_EQ(badDepths, 0) << "worst depth error " << worstDepthError << " pixel footprints";
     EXPECT_EQ(result.stats.rays, static_cast<std::uint64_t>(pixels));
     EXPECT_GT(result.stats.steps, result.stats.rays / 2);
     std::printf("    %s normals %s: %d/%d silhouette pixels differ, worst normal dot %.5f, worst depth error %.2f px\n",
-                std::string(variantName(params.fractal.variant)).c_str(), std::string(normalMethodName(normals)).c_str(),
-                disagreements, pixels, worstDot, worstDepthError);
+                std::string(variantName(params.fractal.variant)).c_str(),
+                std::string(normalMethodName(normals)).c_str(), disagreements, pixels, worstDot, worstDepthError);
 }
 
 }  // namespace
@@ -172,7 +171,7 @@ TEST(RenderBall, AutoFramingKeepsTheSphereInView) {
         EXPECT_NEAR(glm::dot(camera.forward, camera.right), 0.0, 1e-12);
         // The four image edges' midpoints see past the sphere.
         for (const auto& [px, py] : {std::pair{0.0, height / 2.0}, std::pair{double(width), height / 2.0},
-                                      std::pair{width / 2.0, 0.0}, std::pair{width / 2.0, double(height)}}) {
+                                     std::pair{width / 2.0, 0.0}, std::pair{width / 2.0, double(height)}}) {
             const glm::dvec3 direction = camera.rayDirection(px, py);
             const glm::dvec3 offset = camera.eye - bounds.center;
             const double b = glm::dot(offset, direction);

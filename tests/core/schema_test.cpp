@@ -19,7 +19,8 @@ void collectKeys(const Json& node, const std::string& key, std::set<std::string>
     if (!key.empty() && !listItem) keys.insert(key);
     if (key == "animation") return;
     if (node.is_object())
-        for (const auto& item : node.items()) collectKeys(item.value(), key.empty() ? item.key() : key + "." + item.key(), keys);
+        for (const auto& item : node.items())
+            collectKeys(item.value(), key.empty() ? item.key() : key + "." + item.key(), keys);
     const schema::Field* field = key.empty() ? nullptr : schema::find(key);
     if (node.is_array() && field && (field->type == schema::Type::List || field->type == schema::Type::ColorList))
         for (const Json& item : node) collectKeys(item, key + "[]", keys, field->type == schema::Type::List);
@@ -31,7 +32,8 @@ TEST(Schema, DescribesEveryKeyTheWriterWrites) {
     std::set<std::string> written;
     collectKeys(Json::parse(toJson(Params{})), "", written);
     written.erase("version");
-    for (const std::string& key : written) EXPECT_NE(schema::find(key), nullptr) << key << " is written but not in the schema";
+    for (const std::string& key : written)
+        EXPECT_NE(schema::find(key), nullptr) << key << " is written but not in the schema";
     for (const schema::Field& field : schema::fields()) {
         EXPECT_FALSE(field.label.empty()) << field.key;
         EXPECT_FALSE(field.help.empty()) << field.key;
@@ -91,7 +93,8 @@ TEST(Schema, TheReaderEnforcesEveryNumberRangeItDescribes) {
                 parseParams(withValue(key, value, integer).dump(), "test.json", Validation::TypesOnly);
                 return true;
             } catch (const ParamError& error) {
-                EXPECT_NE(std::string(error.what()).find(key.substr(0, key.find('['))), std::string::npos) << error.what();
+                EXPECT_NE(std::string(error.what()).find(key.substr(0, key.find('['))), std::string::npos)
+                    << error.what();
                 return false;
             }
         };

@@ -35,7 +35,8 @@ using dqj::test::Random;
 /// A quaternion uniform in the 4-D ball of `radius`.
 Quat inBall(Random& random, double radius) {
     while (true) {
-        const Quat q = makeQuat(random.uniform(-1, 1), random.uniform(-1, 1), random.uniform(-1, 1), random.uniform(-1, 1));
+        const Quat q =
+            makeQuat(random.uniform(-1, 1), random.uniform(-1, 1), random.uniform(-1, 1), random.uniform(-1, 1));
         if (dqj::dot4(q, q) <= 1.0) return q * radius;
     }
 }
@@ -201,8 +202,7 @@ TEST(Symmetry, NegationIsBitIdentical) {
 
 // ---- orthogonal maps of the imaginary axes -----------------------------------------------------
 
-void checkOrthogonalMap(const glm::dmat3& m, const Fractal& fractal, const DualQuat& z, Random& random,
-                        Tally& tally) {
+void checkOrthogonalMap(const glm::dmat3& m, const Fractal& fractal, const DualQuat& z, Random& random, Tally& tally) {
     const Escape reference = dqj::evaluate(fractal, z);
     if (nearBailout(fractal, z, reference, random)) {
         ++tally.skipped;
@@ -242,8 +242,7 @@ TEST(Symmetry, OrthogonalMapsOfImaginaryAxes) {
 // ---- solids of revolution ----------------------------------------------------------------------
 
 /// `z` and `turned` differ by a rotation that fixes c, so they must give the same result.
-void checkRevolution(const Fractal& fractal, const DualQuat& z, const DualQuat& turned, Random& random,
-                     Tally& tally) {
+void checkRevolution(const Fractal& fractal, const DualQuat& z, const DualQuat& turned, Random& random, Tally& tally) {
     const Escape reference = dqj::evaluate(fractal, z);
     if (nearBailout(fractal, z, reference, random)) {
         ++tally.skipped;
@@ -268,8 +267,9 @@ TEST(Symmetry, ConstantInOneIPlaneGivesSolidOfRevolution) {
             fractal.variant = variant;
             for (int point = 0; point < kPointsPerFractal; ++point) {
                 // b0 in the 1-i plane too, so the rotation in the j-k plane fixes it.
-                const DualQuat z = samplePoint(
-                    fractal, point, {inBall(random, 1.5), makeQuat(random.uniform(-1, 1), random.uniform(-1, 1), 0, 0)});
+                const DualQuat z =
+                    samplePoint(fractal, point,
+                                {inBall(random, 1.5), makeQuat(random.uniform(-1, 1), random.uniform(-1, 1), 0, 0)});
                 const DualQuat turned{makeQuat(z.a.w, z.a.x, std::hypot(z.a.y, z.a.z), 0.0), z.b};
                 checkRevolution(fractal, z, turned, random, tally);
             }

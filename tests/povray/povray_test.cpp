@@ -79,11 +79,12 @@ const char* kPrintMacro =
 /// Scene preamble: the include from the source tree and a tiny object (so POV-Ray does not
 /// warn about an empty scene), and Print.
 const std::string kPreamble = std::string(
-    "#version 3.7;\n"
-    "global_settings { assumed_gamma 1.0 }\n"
-    "#include \"dqjulia.inc\"\n"
-    "sphere { 0, 1 pigment { rgb 1 } }\n"
-    "camera { location <0, 0, -5> look_at 0 }\n") + kPrintMacro;
+                                  "#version 3.7;\n"
+                                  "global_settings { assumed_gamma 1.0 }\n"
+                                  "#include \"dqjulia.inc\"\n"
+                                  "sphere { 0, 1 pigment { rgb 1 } }\n"
+                                  "camera { location <0, 0, -5> look_at 0 }\n") +
+                              kPrintMacro;
 
 class Povray : public ::testing::Test {
 protected:
@@ -102,8 +103,8 @@ protected:
     /// library path; no display, no output file unless the arguments ask for one.
     Outcome povray(const std::string& arguments) {
         const std::string log = path("povray.log");
-        const std::string command = "cd '" + dir_.string() + "' && '" + DQJ_POVRAY + "' -D +L'" + DQJ_POVRAY_INCLUDE_DIR +
-                                    "' " + arguments + " > '" + log + "' 2>&1";
+        const std::string command = "cd '" + dir_.string() + "' && '" + DQJ_POVRAY + "' -D +L'" +
+                                    DQJ_POVRAY_INCLUDE_DIR + "' " + arguments + " > '" + log + "' 2>&1";
         const auto start = std::chrono::steady_clock::now();
         const int status = std::system(command.c_str());
         Outcome result;
@@ -202,7 +203,7 @@ dqj::Fractal fractal(const dqj::Vec8& c, dqj::Variant variant, int iterations, d
 }
 
 const dqj::Vec8 kC1{-0.10, 0.8, -0.26, 0.15, -0.23, -0.38, -0.86, 0.64};  // math.md, the paper's first example
-const dqj::Vec8 kC2{-0.39054, -0.58679, 0, 0, 0, 0.5632, 0, 0.05};     // math.md, the paper's high-detail constant
+const dqj::Vec8 kC2{-0.39054, -0.58679, 0, 0, 0, 0.5632, 0, 0.05};        // math.md, the paper's high-detail constant
 const dqj::Vec8 kTest2{-0.67, -0.54, -0.07, 0.02, 0.06, -0.53, 0.15, -0.27};  // examples/paper-test2-2.json
 
 std::vector<Case> agreementCases() {
@@ -212,7 +213,8 @@ std::vector<Case> agreementCases() {
     const std::string standardSdl = "DQJ_Slice_Names(\"a.s,a.i,a.j\")";
     for (const auto& [label, c] : {std::pair{"c1", kC1}, std::pair{"c2", kC2}}) {
         cases.push_back({std::string(label) + "-paper", fractal(c, Variant::Paper, 15), standard, standardSdl});
-        cases.push_back({std::string(label) + "-coupled", fractal(c, Variant::PaperCoupled, 15, 6.0), standard, standardSdl});
+        cases.push_back(
+            {std::string(label) + "-coupled", fractal(c, Variant::PaperCoupled, 15, 6.0), standard, standardSdl});
         cases.push_back({std::string(label) + "-dual", fractal(c, Variant::Dual, 15), standard, standardSdl});
     }
     // A slice that mixes real and dual axes, with an origin off 0 and a rotation, built in SDL
@@ -272,15 +274,16 @@ TEST_F(Povray, IncludeFunctionsEqualTheCoresDistanceEstimate) {
               << "#declare C" << id << " = " << array8(dqj::toVec8(test.fractal.c)) << ";\n"
               << "#declare S" << id << " = " << test.sliceSdl << ";\n"
               << "#declare V" << id << " = \"" << dqj::variantName(test.fractal.variant) << "\";\n"
-              << "#declare D" << id << " = DQJ_Distance_Function(C" << id << ", V" << id << ", " << test.fractal.iterations
-              << ", " << number(test.fractal.bailout) << ", S" << id << ");\n"
+              << "#declare D" << id << " = DQJ_Distance_Function(C" << id << ", V" << id << ", "
+              << test.fractal.iterations << ", " << number(test.fractal.bailout) << ", S" << id << ");\n"
               << "#declare T" << id << " = DQJ_Trap_Function(C" << id << ", V" << id << ", " << test.fractal.iterations
               << ", " << number(test.fractal.bailout) << ", S" << id << ");\n"
               << "#declare I" << id << " = DQJ_Iteration_Function(C" << id << ", V" << id << ", "
               << test.fractal.iterations << ", " << number(test.fractal.bailout) << ", S" << id << ");\n"
               << "#declare B" << id << " = DQJ_Bounds(C" << id << ", V" << id << ", S" << id << ");\n"
-              << "#debug concat(\"BOUNDS " << id << " \", Print(B" << id << ".x), \" \", Print(B" << id << ".y), \" \", Print(B"
-              << id << ".z), \" \", Print(B" << id << ".t), \" \", Print(DQJ_Stretch(S" << id << ")), \"\\n\")\n";
+              << "#debug concat(\"BOUNDS " << id << " \", Print(B" << id << ".x), \" \", Print(B" << id
+              << ".y), \" \", Print(B" << id << ".z), \" \", Print(B" << id << ".t), \" \", Print(DQJ_Stretch(S" << id
+              << ")), \"\\n\")\n";
         const auto bounds = dqj::containingBounds(test.fractal, test.slice);
         ASSERT_TRUE(bounds) << test.name;
         expectedBounds[id] = {*bounds, dqj::stretchOf(test.slice).max};
@@ -291,8 +294,8 @@ TEST_F(Povray, IncludeFunctionsEqualTheCoresDistanceEstimate) {
             const dqj::Escape escape = dqj::evaluate(test.fractal, test.slice.map(point));
             const std::string key = id + "." + std::to_string(p);
             const std::string args = number(point.x) + ", " + number(point.y) + ", " + number(point.z);
-            scene << "#debug concat(\"DE " << key << " \", Print(D" << id << "(" << args << ")), \" \", Print(T" << id << "("
-                  << args << ")), \" \", Print(I" << id << "(" << args << ")), \"\\n\")\n";
+            scene << "#debug concat(\"DE " << key << " \", Print(D" << id << "(" << args << ")), \" \", Print(T" << id
+                  << "(" << args << ")), \" \", Print(I" << id << "(" << args << ")), \"\\n\")\n";
             expected[key + ".de"] = {test.name, escape.de, true};
             expected[key + ".trap"] = {test.name, escape.trap, false};
             // DQJ_Iteration_Function is the core's smooth count over N (coloring.hpp).
@@ -386,8 +389,8 @@ double compareColours(const std::vector<std::string>& lines, const std::map<std:
         fields >> key >> colour.x >> colour.y >> colour.z;
         EXPECT_FALSE(fields.fail()) << line;
         const glm::dvec3& want = expected.at(key);
-        const double difference = std::max({std::abs(colour.x - want.x), std::abs(colour.y - want.y),
-                                            std::abs(colour.z - want.z)});
+        const double difference =
+            std::max({std::abs(colour.x - want.x), std::abs(colour.y - want.y), std::abs(colour.z - want.z)});
         worst = std::max(worst, difference);
         EXPECT_LE(difference, tolerance) << key << ": POV-Ray " << line << ", core " << want.x << " " << want.y << " "
                                          << want.z;
@@ -485,8 +488,8 @@ TEST_F(Povray, IncludeColouringEqualsTheCoresColoringUnit) {
     EXPECT_GT(inside, 10u);
     std::cout << "[ povray   ] colouring at " << escaped + inside << " points of " << cases.size()
               << " configurations (" << escaped << " escaped, " << inside
-              << " inside): largest difference of trap scale and colouring values "
-              << worstValue << ", of palette colours (" << colours.size() << ") " << worstColour << "\n";
+              << " inside): largest difference of trap scale and colouring values " << worstValue
+              << ", of palette colours (" << colours.size() << ") " << worstColour << "\n";
     RecordProperty("max_colour_difference", number(worstColour));
 }
 
@@ -589,9 +592,12 @@ TEST_F(Povray, IncludeParsesCleanlyWithEveryMacro) {
 TEST_F(Povray, BadArgumentsStopWithAClearMessage) {
     const std::string c = "#declare C = array[8] {-0.39054, -0.58679, 0, 0, 0, 0.5632, 0, 0.05};\n";
     const std::vector<std::pair<std::string, std::string>> cases = {
-        {"#declare F = DQJ_Distance_Function(C, \"quaternion\", 6, 4, DQJ_Slice_Names(\"a.s,a.i,a.j\"));", "unknown variant"},
-        {"#declare F = DQJ_Distance_Function(C, \"paper\", 1001, 4, DQJ_Slice_Names(\"a.s,a.i,a.j\"));", "from 1 to 1000"},
-        {"#declare F = DQJ_Distance_Function(C, \"paper\", 6, 1.2, DQJ_Slice_Names(\"a.s,a.i,a.j\"));", "below the containment"},
+        {"#declare F = DQJ_Distance_Function(C, \"quaternion\", 6, 4, DQJ_Slice_Names(\"a.s,a.i,a.j\"));",
+         "unknown variant"},
+        {"#declare F = DQJ_Distance_Function(C, \"paper\", 1001, 4, DQJ_Slice_Names(\"a.s,a.i,a.j\"));",
+         "from 1 to 1000"},
+        {"#declare F = DQJ_Distance_Function(C, \"paper\", 6, 1.2, DQJ_Slice_Names(\"a.s,a.i,a.j\"));",
+         "below the containment"},
         {"#declare S = DQJ_Slice_Names(\"a.s,a.s,a.j\");", "named twice"},
         {"#declare S = DQJ_Slice_Names(\"a.s,a.x,a.j\");", "unknown axis \"a.x\""},
         {"#declare S = DQJ_Slice_Names(\"a.s,a.i\");", "exactly 3 axes"},
@@ -683,7 +689,8 @@ TEST_F(Povray, GeneratedScenesDrawTheSilhouetteOfDqjuliaRender) {
     const std::vector<View> views = {
         {"default (paper, c2, N = 15)", R"({"variant": "paper", "iterations": 15})", "", 0.95},
         {"dual, c1, N = 12",
-         R"({"c": [-0.10, 0.8, -0.26, 0.15, -0.23, -0.38, -0.86, 0.64], "variant": "dual", "iterations": 12})", "", 0.95},
+         R"({"c": [-0.10, 0.8, -0.26, 0.15, -0.23, -0.38, -0.86, 0.64], "variant": "dual", "iterations": 12})", "",
+         0.95},
         {"paper-coupled, test2-2, turned slice",
          R"({"c": [-0.67, -0.54, -0.07, 0.02, 0.06, -0.53, 0.15, -0.27], "variant": "paper-coupled", "iterations": 8, "bailout": 6})",
          R"({"axes": "a.s,a.i,a.j", "origin": [0, 0, 0, 0, 0, 0.05, 0, 0], "rotations": [{"plane": "a.j,a.k", "degrees": 40}]})",
@@ -723,7 +730,8 @@ TEST_F(Povray, Df3SceneDrawsTheSameSilhouetteFromTheGrid) {
     const std::string params = write("p.json", silhouetteParams(R"({"variant": "paper", "iterations": 15})", ""));
     const dqj::Image core = dqj::render(dqj::loadParams(params)).image;
     std::string err;
-    ASSERT_EQ(cli("povray -q --df3 --df3-resolution 160 -p '" + params + "' -o '" + path("grid.pov") + "'", &err), 0) << err;
+    ASSERT_EQ(cli("povray -q --df3 --df3-resolution 160 -p '" + params + "' -o '" + path("grid.pov") + "'", &err), 0)
+        << err;
     ASSERT_TRUE(fs::exists(path("grid.df3")));
     ASSERT_TRUE(fs::exists(path("grid_df3.pov")));
     EXPECT_EQ(fs::file_size(path("grid.df3")), 6u + 2u * 160u * 160u * 160u);  // 16-bit samples

@@ -67,22 +67,22 @@ static int refuse_tmpfile(int flags) {
     return (flags & O_TMPFILE) == O_TMPFILE && value && strcmp(value, "1") == 0;
 }
 
-#define DQJ_OPEN_WRAPPER(name)                                                       \
-    int name(const char* path, int flags, ...) {                                     \
-        static int (*real)(const char*, int, ...);                                   \
-        if (!real) real = (int (*)(const char*, int, ...))dlsym(RTLD_NEXT, #name);   \
-        mode_t mode = 0;                                                             \
-        if (flags & (O_CREAT | O_TMPFILE)) {                                         \
-            va_list arguments;                                                       \
-            va_start(arguments, flags);                                              \
-            mode = va_arg(arguments, mode_t);                                        \
-            va_end(arguments);                                                       \
-        }                                                                            \
-        if (refuse_tmpfile(flags)) {                                                 \
-            errno = EOPNOTSUPP;                                                      \
-            return -1;                                                               \
-        }                                                                            \
-        return real(path, flags, mode);                                              \
+#define DQJ_OPEN_WRAPPER(name)                                                     \
+    int name(const char* path, int flags, ...) {                                   \
+        static int (*real)(const char*, int, ...);                                 \
+        if (!real) real = (int (*)(const char*, int, ...))dlsym(RTLD_NEXT, #name); \
+        mode_t mode = 0;                                                           \
+        if (flags & (O_CREAT | O_TMPFILE)) {                                       \
+            va_list arguments;                                                     \
+            va_start(arguments, flags);                                            \
+            mode = va_arg(arguments, mode_t);                                      \
+            va_end(arguments);                                                     \
+        }                                                                          \
+        if (refuse_tmpfile(flags)) {                                               \
+            errno = EOPNOTSUPP;                                                    \
+            return -1;                                                             \
+        }                                                                          \
+        return real(path, flags, mode);                                            \
     }
 DQJ_OPEN_WRAPPER(open)
 DQJ_OPEN_WRAPPER(open64)

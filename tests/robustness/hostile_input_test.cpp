@@ -44,7 +44,9 @@ protected:
         const std::vector<std::string> names = dqj::test::fileNames(folder);
         return {names.begin(), names.end()};
     }
-    void write(const std::string& name, const std::string& text) const { std::ofstream(dir_ / name, std::ios::binary) << text; }
+    void write(const std::string& name, const std::string& text) const {
+        std::ofstream(dir_ / name, std::ios::binary) << text;
+    }
     /// A small tmpfs at dir_/name of `size` (e.g. "64k"), as mount_; false if mounting is not allowed here.
     bool mountTmpfs(const std::string& name, const std::string& size) {
         mount_ = dir_ / name;
@@ -175,8 +177,9 @@ TEST_F(Hostile, MessagesKeepWhatFollowsANulByte) {
 
 TEST_F(Hostile, AnInterruptedReadOfTheParameterFileExits130) {
     ASSERT_EQ(::mkfifo((dir_ / "params.json").c_str(), 0600), 0);  // no writer: the open blocks
-    const pid_t pid = dqj::test::spawnProgram(DQJ_CLI, {"render", "-q", "-p", (dir_ / "params.json").string(), "-o",
-                                                        (dir_ / "out.png").string()},
+    const pid_t pid = dqj::test::spawnProgram(DQJ_CLI,
+                                              {"render", "-q", "-p", (dir_ / "params.json").string(), "-o",
+                                               (dir_ / "out.png").string()},
                                               dir_ / "stderr.txt");
     ASSERT_GT(pid, 0);
     std::this_thread::sleep_for(std::chrono::milliseconds(700));
@@ -212,7 +215,8 @@ TEST_F(Hostile, WhatFlagsSetIsCheckedWithTheFileFormatsRanges) {
     // A flag may not set what --save-params would write as a file that does not read back.
     for (const std::string flags : {"--bailout 1e200", "--c 1000 0 0 0 0 0 0 0", "--detail 5000", "--max-steps 2000000",
                                     "--rotate a.j,b.s:1e9", "--camera-position 1e10 0 0"}) {
-        const auto result = run("render -q -W 8 -H 8 " + flags + " -o " + path("out.png") + " --save-params " + path("p.json"));
+        const auto result =
+            run("render -q -W 8 -H 8 " + flags + " -o " + path("out.png") + " --save-params " + path("p.json"));
         EXPECT_EQ(result.exitCode, 2) << flags << ": " << result.err;
         EXPECT_CONTAINS(result.err, "must be");
         EXPECT_TRUE(filesIn(dir_).empty()) << flags;
@@ -242,8 +246,9 @@ TEST_F(Hostile, SaveParamsOntoTheImageIsRejected) {
 
 TEST_F(Hostile, AFileThatAppearsDuringTheWorkIsNotReplacedWithoutForce) {
     const fs::path output = dir_ / "race.png";
-    const pid_t pid = dqj::test::spawnProgram(DQJ_CLI, {"render", "-q", "-W", "800", "-H", "600", "-s", "2", "-o", output.string()},
-                                              dir_ / "stderr.txt");
+    const pid_t pid =
+        dqj::test::spawnProgram(DQJ_CLI, {"render", "-q", "-W", "800", "-H", "600", "-s", "2", "-o", output.string()},
+                                dir_ / "stderr.txt");
     ASSERT_GT(pid, 0);
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
     std::ofstream(output) << "the other run's picture";  // another run finished first
@@ -295,11 +300,13 @@ TEST_F(Hostile, ThePovrayIncludeStopsOnInvalidSettings) {
         {"DQJ_Slice_Names(\"a.s,a.i,a.j\")", "4", "-0.01", "threshold must be 0 or more"},
     };
     for (const Case& test : cases) {
-        write("bad.pov", std::string("#version 3.7;\n#include \"dqjulia.inc\"\n") +
-                             "#declare C = array[8] {-0.39054, -0.58679, 0, 0, 0, 0.5632, 0, 0.05};\n#declare S = " +
-                             test.slice + ";\ncamera { location <0, 0, -4> look_at 0 }\nobject { DQJ_Isosurface(C, \"paper\", 6, " +
-                             test.bailout + ", S, " + test.threshold + ") pigment { rgb 1 } }\n");
-        const std::string command = "cd '" + dir_.string() + "' && povray +W8 +H6 -D +Ibad.pov +Obad.png > povray.txt 2>&1";
+        write("bad.pov",
+              std::string("#version 3.7;\n#include \"dqjulia.inc\"\n") +
+                  "#declare C = array[8] {-0.39054, -0.58679, 0, 0, 0, 0.5632, 0, 0.05};\n#declare S = " + test.slice +
+                  ";\ncamera { location <0, 0, -4> look_at 0 }\nobject { DQJ_Isosurface(C, \"paper\", 6, " +
+                  test.bailout + ", S, " + test.threshold + ") pigment { rgb 1 } }\n");
+        const std::string command =
+            "cd '" + dir_.string() + "' && povray +W8 +H6 -D +Ibad.pov +Obad.png > povray.txt 2>&1";
         EXPECT_NE(std::system(command.c_str()), 0) << test.message;
         EXPECT_CONTAINS(readFile(dir_ / "povray.txt"), test.message);
         EXPECT_FALSE(fs::exists(dir_ / "bad.png"));
@@ -312,8 +319,9 @@ TEST_F(Hostile, SighupStopsABakeLikeSigtermAndSigkillLeavesNoTemporaryFile) {
     const fs::path output = dir_ / "fractal.vdb";
     for (int signal : {SIGHUP, SIGKILL}) {
         std::ofstream(output) << "previous bake";
-        const pid_t pid = dqj::test::spawnProgram(DQJ_CLI, {"bake", "-q", "--force", "-r", "512", "-o", output.string()},
-                                                  dir_ / "stderr.txt");
+        const pid_t pid =
+            dqj::test::spawnProgram(DQJ_CLI, {"bake", "-q", "--force", "-r", "512", "-o", output.string()},
+                                    dir_ / "stderr.txt");
         ASSERT_GT(pid, 0);
         std::this_thread::sleep_for(std::chrono::milliseconds(1000));
         ASSERT_EQ(::kill(pid, signal), 0);
@@ -348,8 +356,8 @@ TEST_F(Hostile, TheBakeMemoryGuardRespectsTheProcessLimit) {
 #else
     const auto start = std::chrono::steady_clock::now();
     // An explicit --max-memory far above the cap: only the process limit can refuse it in time.
-    const std::string command = "ulimit -v 1200000; '" + std::string(DQJ_CLI) + "' bake -q -r 4096 --max-memory 100G -o " + path("big.vdb") +
-                                " 2> " + path("err.txt");
+    const std::string command = "ulimit -v 1200000; '" + std::string(DQJ_CLI) +
+                                "' bake -q -r 4096 --max-memory 100G -o " + path("big.vdb") + " 2> " + path("err.txt");
     const int status = std::system(command.c_str());
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     EXPECT_EQ(WEXITSTATUS(status), 2) << readFile(dir_ / "err.txt");
@@ -385,9 +393,10 @@ TEST(HostileC, DestroyingAContextFromItsOwnCallbackIsRefused) {
         DestroyAttempt attempt{context};
         const std::string vdb = (folder / "bake.vdb").string();
         std::vector<std::uint8_t> pixels(16 * 16 * 4);
-        const dqj_status status = call == 0   ? dqj_mesh_compute(context, destroyFromCallback, &attempt)
-                                  : call == 1 ? dqj_bake_vdb(context, vdb.c_str(), destroyFromCallback, &attempt)
-                                              : dqj_render_rgba8(context, pixels.data(), 16, 16, 64, destroyFromCallback, &attempt);
+        const dqj_status status =
+            call == 0   ? dqj_mesh_compute(context, destroyFromCallback, &attempt)
+            : call == 1 ? dqj_bake_vdb(context, vdb.c_str(), destroyFromCallback, &attempt)
+                        : dqj_render_rgba8(context, pixels.data(), 16, 16, 64, destroyFromCallback, &attempt);
         EXPECT_TRUE(attempt.tried);
         EXPECT_EQ(attempt.status, DQJ_ERROR_BUSY) << call;
         EXPECT_EQ(status, DQJ_OK) << dqj_context_error(context);
@@ -486,11 +495,11 @@ protected:
         const std::string out = (dir_ / "faulty").string(), ok = (dir_ / "ok").string();
         arguments.replace(arguments.find("OUT"), 3, out);
         if (arguments.find("OK") != std::string::npos) arguments.replace(arguments.find("OK"), 2, ok);
-        const std::string environment = "env LD_PRELOAD='" + std::string(DQJ_FAULT_SHIM) + "' DQJ_FAULT_DIR='" + out +
-                                        "' DQJ_FAULT_MODE=" + mode + " DQJ_FAULT_AFTER=" + std::to_string(after) +
-                                        " DQJ_FAULT_NO_TMPFILE=" + (noTmpfile_ ? "1" : "0") +
-                                        " ASAN_OPTIONS=verify_asan_link_order=0:detect_leaks=0:exitcode=86 UBSAN_OPTIONS=exitcode=86 '" +
-                                        DQJ_CLI + "' ";  // a sanitizer report is never taken for exit 1
+        const std::string environment =
+            "env LD_PRELOAD='" + std::string(DQJ_FAULT_SHIM) + "' DQJ_FAULT_DIR='" + out + "' DQJ_FAULT_MODE=" + mode +
+            " DQJ_FAULT_AFTER=" + std::to_string(after) + " DQJ_FAULT_NO_TMPFILE=" + (noTmpfile_ ? "1" : "0") +
+            " ASAN_OPTIONS=verify_asan_link_order=0:detect_leaks=0:exitcode=86 UBSAN_OPTIONS=exitcode=86 '" + DQJ_CLI +
+            "' ";  // a sanitizer report is never taken for exit 1
         return dqj::test::runCommand("/bin/sh", "-c \"" + environment + arguments + " --force\"", dir_);
     }
 };
@@ -518,32 +527,40 @@ TEST_P(FaultInjection, EveryFailureIsReportedAndLeavesTheOldFiles) {
         const char* reason;
     };
     const long long all = static_cast<long long>(total);
-    const std::vector<Point> points{{"enospc", 0, "No space left on device"},        {"enospc", 1, "No space left on device"},
-                                    {"enospc", all / 2, "No space left on device"},  {"enospc", all - 1, "No space left on device"},
-                                    {"short", all / 3, "No space left on device"},   {"short", all - 1, "No space left on device"},
-                                    {"fsync", 0, "Input/output error"},             {"close", 0, "Input/output error"}};
+    const std::vector<Point> points{{"enospc", 0, "No space left on device"},
+                                    {"enospc", 1, "No space left on device"},
+                                    {"enospc", all / 2, "No space left on device"},
+                                    {"enospc", all - 1, "No space left on device"},
+                                    {"short", all / 3, "No space left on device"},
+                                    {"short", all - 1, "No space left on device"},
+                                    {"fsync", 0, "Input/output error"},
+                                    {"close", 0, "Input/output error"}};
     for (const bool noTmpfile : {false, true})
-    for (const Point& point : points) {
-        noTmpfile_ = noTmpfile;
-        SCOPED_TRACE(point.mode + " after " + std::to_string(point.after) + " bytes" + (noTmpfile ? ", without O_TMPFILE" : ""));
-        resetOld();
-        const auto result = runWith(point.mode, point.after);
-        EXPECT_EQ(result.exitCode, 1) << result.err;
-        EXPECT_CONTAINS(result.err, point.reason);
-        EXPECT_CONTAINS(result.err, "cannot write '" + faulty.string() + "/");
-        const std::set<std::string> left = filesIn(faulty);
-        EXPECT_FALSE(hasTemporary(left));
-        // Each output is either its old content or complete (a multi-file writer publishes
-        // its files one by one); the file the fault hit, and every later one, stays old.
-        long long before = 0;
-        for (const char* name : GetParam().outputs) {
-            const std::string content = readFile(faulty / name);
-            const bool hit = point.mode == "fsync" || point.mode == "close" || point.after < before + (long long)sizes[name];
-            if (hit || before > point.after) EXPECT_EQ(content, std::string("old ") + name) << name;
-            else EXPECT_EQ(content.size(), sizes[name]) << name;
-            before += (long long)sizes[name];
+        for (const Point& point : points) {
+            noTmpfile_ = noTmpfile;
+            SCOPED_TRACE(point.mode + " after " + std::to_string(point.after) + " bytes" +
+                         (noTmpfile ? ", without O_TMPFILE" : ""));
+            resetOld();
+            const auto result = runWith(point.mode, point.after);
+            EXPECT_EQ(result.exitCode, 1) << result.err;
+            EXPECT_CONTAINS(result.err, point.reason);
+            EXPECT_CONTAINS(result.err, "cannot write '" + faulty.string() + "/");
+            const std::set<std::string> left = filesIn(faulty);
+            EXPECT_FALSE(hasTemporary(left));
+            // Each output is either its old content or complete (a multi-file writer publishes
+            // its files one by one); the file the fault hit, and every later one, stays old.
+            long long before = 0;
+            for (const char* name : GetParam().outputs) {
+                const std::string content = readFile(faulty / name);
+                const bool hit =
+                    point.mode == "fsync" || point.mode == "close" || point.after < before + (long long)sizes[name];
+                if (hit || before > point.after)
+                    EXPECT_EQ(content, std::string("old ") + name) << name;
+                else
+                    EXPECT_EQ(content.size(), sizes[name]) << name;
+                before += (long long)sizes[name];
+            }
         }
-    }
     // Short writes alone (no space problem) must still give complete files, with and without
     // O_TMPFILE, and leave no hidden file.
     for (const bool noTmpfile : {false, true}) {

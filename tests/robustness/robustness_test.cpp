@@ -47,8 +47,10 @@ TEST_P(Interrupt, StopsARenderPromptlyAndKeepsThePreviousOutput) {
     const fs::path output = dir_ / "picture.png";
     std::ofstream(output) << "previous picture";
     // Long enough to be interrupted: several seconds of work on 2 cores.
-    const pid_t pid = dqj::test::spawnProgram(DQJ_CLI, {"render", "--force", "-W", "1600", "-H", "1200", "-s", "4", "-o", output.string()},
-                               dir_ / "stderr.txt");
+    const pid_t pid =
+        dqj::test::spawnProgram(DQJ_CLI,
+                                {"render", "--force", "-W", "1600", "-H", "1200", "-s", "4", "-o", output.string()},
+                                dir_ / "stderr.txt");
     ASSERT_GT(pid, 0);
     std::this_thread::sleep_for(std::chrono::milliseconds(1000));  // well past start-up, even under sanitizers
     const auto sent = std::chrono::steady_clock::now();
@@ -71,7 +73,9 @@ TEST_F(Scratch, FullDiskIsReportedAndLeavesNothing) {
     if (!tiny.mounted()) GTEST_SKIP() << "cannot mount a small tmpfs here (" << std::strerror(errno) << "); needs root";
     const fs::path& disk = tiny.path();
     const fs::path output = disk / "big.png";
-    const pid_t pid = dqj::test::spawnProgram(DQJ_CLI, {"render", "-q", "-W", "640", "-H", "480", "-o", output.string()}, dir_ / "stderr.txt");
+    const pid_t pid =
+        dqj::test::spawnProgram(DQJ_CLI, {"render", "-q", "-W", "640", "-H", "480", "-o", output.string()},
+                                dir_ / "stderr.txt");
     ASSERT_GT(pid, 0);
     EXPECT_EQ(waitExit(pid), 1);
     const std::string err = readFile(dir_ / "stderr.txt");
@@ -118,9 +122,11 @@ TEST(ConcurrentContexts, GiveTheSameResultsAsOneThread) {
                     ++failures[index];
                 const std::vector<dqj_sample> samples = evaluateGrid(context);
                 for (std::size_t i = 0; i < samples.size(); ++i)
-                    if (samples[i].n != expectedSamples[i].n || samples[i].de != expectedSamples[i].de) ++failures[index];
+                    if (samples[i].n != expectedSamples[i].n || samples[i].de != expectedSamples[i].de)
+                        ++failures[index];
                 std::vector<unsigned char> image(expectedImage.size());
-                if (dqj_render_rgba8(context, image.data(), 48, 36, 48 * 4, nullptr, nullptr) != DQJ_OK || image != expectedImage)
+                if (dqj_render_rgba8(context, image.data(), 48, 36, 48 * 4, nullptr, nullptr) != DQJ_OK ||
+                    image != expectedImage)
                     ++failures[index];
                 dqj_context_destroy(context);
             }

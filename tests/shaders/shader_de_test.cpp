@@ -69,7 +69,8 @@ double derivativeOf(const dqj::Escape& e) {
 }
 
 /// Is a disagreement of escape counts explained by float rounding (see the file comment)?
-bool escapeDisagreementExplained(const dqj::Fractal& fractal, const dqj::DualQuat& start, int floatEscape, int doubleEscape) {
+bool escapeDisagreementExplained(const dqj::Fractal& fractal, const dqj::DualQuat& start, int floatEscape,
+                                 int doubleEscape) {
     for (double factor : {1.0 - 1e-4, 1.0 + 1e-4}) {
         dqj::Fractal moved = fractal;
         moved.bailout *= factor;
@@ -102,10 +103,10 @@ struct Agreement {
     long points = 0;
     long escapeMismatches = 0;
     long unexplainedMismatches = 0;
-    long compared = 0;                // both escaped at the same iteration
-    double maxRelative = 0.0;         // over all compared points
-    double maxRelativeModerate = 0.0; // where |dz| <= 100 (away from the set's surface)
-    double maxRatioToBound = 0.0;     // max of relative / (eps_float * max(1, |dz|))
+    long compared = 0;                 // both escaped at the same iteration
+    double maxRelative = 0.0;          // over all compared points
+    double maxRelativeModerate = 0.0;  // where |dz| <= 100 (away from the set's surface)
+    double maxRatioToBound = 0.0;      // max of relative / (eps_float * max(1, |dz|))
     long overTolerance = 0;
 
     void add(const Agreement& other) {
@@ -196,13 +197,15 @@ void report(const char* backend, const Agreement& total) {
         "[%s] %ld points: escape count differs at %ld (%.4f%%; %ld unexplained); DE compared at %ld: max relative "
         "difference %.3g overall, %.3g where |dz| <= 100; max (relative / (eps_float * max(1,|dz|))) = %.1f\n",
         backend, total.points, total.escapeMismatches, 100.0 * total.escapeMismatches / std::max(1L, total.points),
-        total.unexplainedMismatches, total.compared, total.maxRelative, total.maxRelativeModerate, total.maxRatioToBound);
+        total.unexplainedMismatches, total.compared, total.maxRelative, total.maxRelativeModerate,
+        total.maxRatioToBound);
 }
 
 void checkAgreement(const char* backend, const Agreement& total) {
     report(backend, total);
     EXPECT_EQ(total.unexplainedMismatches, 0) << backend;
-    EXPECT_LT(double(total.escapeMismatches), 0.01 * double(total.points)) << backend << ": too many escape disagreements";
+    EXPECT_LT(double(total.escapeMismatches), 0.01 * double(total.points))
+        << backend << ": too many escape disagreements";
     EXPECT_EQ(total.overTolerance, 0) << backend << ": DE beyond 16 eps_float * max(1, |dz|)";
     EXPECT_LT(total.maxRelativeModerate, 1e-4) << backend;
     EXPECT_GT(total.compared, total.points / 4) << backend;
@@ -217,13 +220,17 @@ TEST(ShaderDistanceEstimate, GlslMatchesCore) {
                 const dqj::Fractal fractal = roundedFractal(config.c, variant, iterations);
                 Agreement one;
                 for (const dqj::DualQuat& z : samplePoints(fractal, 4000, seed++)) {
-                    compare(fractal, z, [&](int& n, float& de) {
-                        const glsl::DqjEscape e = glsl::dqj_evaluate(
-                            quatToVec4(z.a), quatToVec4(z.b), quatToVec4(fractal.c.a), quatToVec4(fractal.c.b),
-                            int(variant), iterations, float(fractal.bailout));
-                        n = e.n;
-                        de = e.de;
-                    }, one);
+                    compare(
+                        fractal, z,
+                        [&](int& n, float& de) {
+                            const glsl::DqjEscape e =
+                                glsl::dqj_evaluate(quatToVec4(z.a), quatToVec4(z.b), quatToVec4(fractal.c.a),
+                                                   quatToVec4(fractal.c.b), int(variant), iterations,
+                                                   float(fractal.bailout));
+                            n = e.n;
+                            de = e.de;
+                        },
+                        one);
                 }
                 total.add(one);
                 if (one.unexplainedMismatches || one.overTolerance)
@@ -242,14 +249,17 @@ TEST(ShaderDistanceEstimate, OslMatchesCore) {
             for (int iterations : kIterations) {
                 const dqj::Fractal fractal = roundedFractal(config.c, variant, iterations);
                 for (const dqj::DualQuat& z : samplePoints(fractal, 4000, seed++)) {
-                    compare(fractal, z, [&](int& n, float& de) {
-                        const glm::vec4 a = quatToVec4(z.a), b = quatToVec4(z.b);
-                        const glm::vec4 ca = quatToVec4(fractal.c.a), cb = quatToVec4(fractal.c.b);
-                        float r = 0.0f, trap = 0.0f;
-                        osl::dqj_evaluate(a.x, glm::vec3(a.y, a.z, a.w), b.x, glm::vec3(b.y, b.z, b.w), ca.x,
-                                          glm::vec3(ca.y, ca.z, ca.w), cb.x, glm::vec3(cb.y, cb.z, cb.w), int(variant),
-                                          iterations, float(fractal.bailout), n, r, de, trap);
-                    }, total);
+                    compare(
+                        fractal, z,
+                        [&](int& n, float& de) {
+                            const glm::vec4 a = quatToVec4(z.a), b = quatToVec4(z.b);
+                            const glm::vec4 ca = quatToVec4(fractal.c.a), cb = quatToVec4(fractal.c.b);
+                            float r = 0.0f, trap = 0.0f;
+                            osl::dqj_evaluate(a.x, glm::vec3(a.y, a.z, a.w), b.x, glm::vec3(b.y, b.z, b.w), ca.x,
+                                              glm::vec3(ca.y, ca.z, ca.w), cb.x, glm::vec3(cb.y, cb.z, cb.w),
+                                              int(variant), iterations, float(fractal.bailout), n, r, de, trap);
+                        },
+                        total);
                 }
             }
         }
@@ -340,7 +350,8 @@ TEST(ShaderMarch, SilhouetteMatchesCoreRender) {
     const std::vector<Case> cases{
         {"defaults (paper, c2, N=15)", "{}"},
         {"paper-coupled, N=10", R"({"fractal": {"variant": "paper-coupled", "iterations": 10, "bailout": 4.2}})"},
-        {"dual, c4, N=30", R"({"fractal": {"variant": "dual", "iterations": 30, "c": [-0.2, 0.6, 0.2, 0, 0, 0, 0, 0]}})"},
+        {"dual, c4, N=30",
+         R"({"fractal": {"variant": "dual", "iterations": 30, "c": [-0.2, 0.6, 0.2, 0, 0, 0, 0, 0]}})"},
         {"turned slice", R"({"slice": {"axes": "a.s,a.i,a.j", "rotations": [{"plane": "a.j,a.k", "degrees": 35}]}})"},
     };
     for (const Case& item : cases) {
@@ -482,9 +493,10 @@ TEST(ShaderShading, GlslColouringMatchesCore) {
             }
         }
     }
-    std::printf("[GLSL colouring] %ld colours compared (%ld escaped, %ld inside points): largest colour difference "
-                "solid %.3g, iterations %.3g, trap %.3g; smooth count / N %.3g, trap scale (relative) %.3g\n",
-                compared, escaped, inside, worst[0], worst[1], worst[2], worstSmooth, worstTrapScale);
+    std::printf(
+        "[GLSL colouring] %ld colours compared (%ld escaped, %ld inside points): largest colour difference "
+        "solid %.3g, iterations %.3g, trap %.3g; smooth count / N %.3g, trap scale (relative) %.3g\n",
+        compared, escaped, inside, worst[0], worst[1], worst[2], worstSmooth, worstTrapScale);
     EXPECT_LE(worst[0], kEpsFloat);  // the material colour, rounded to float
     EXPECT_LE(worstSmooth, 16.0 * kEpsFloat);
     EXPECT_LE(worstTrapScale, 2.0 * kEpsFloat);
@@ -535,7 +547,7 @@ TEST(ShaderShading, GlslPhongMatchesCore) {
 
             const glm::dvec3 core = dqj::phongLight(material, base, normal, toLight, toEye, radiance, open);
             const glm::vec3 shader = glsl::dqj_phong_light(m, glm::vec3(base), glm::vec3(normal), glm::vec3(toLight),
-                                                          glm::vec3(toEye), glm::vec3(radiance), float(open));
+                                                           glm::vec3(toEye), glm::vec3(radiance), float(open));
             // The terms' size: what the light could give at most here.
             const double size = (material.diffuse + material.specular) * std::max({radiance.x, radiance.y, radiance.z});
             const double difference = largestDifference(core, shader);
@@ -550,9 +562,10 @@ TEST(ShaderShading, GlslPhongMatchesCore) {
             }
         }
     }
-    std::printf("[GLSL Phong] %ld lit, %ld behind (%ld grazing left out): largest difference ambient %.3g, one light "
-                "%.3g; max difference / (eps_float (1 + s) size) = %.2f\n",
-                lit, behind, grazing, worstAmbient, worstLight, worstRatio);
+    std::printf(
+        "[GLSL Phong] %ld lit, %ld behind (%ld grazing left out): largest difference ambient %.3g, one light "
+        "%.3g; max difference / (eps_float (1 + s) size) = %.2f\n",
+        lit, behind, grazing, worstAmbient, worstLight, worstRatio);
     EXPECT_GT(lit, 5000);
     EXPECT_GT(behind, 5000);
 }

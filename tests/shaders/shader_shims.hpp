@@ -10,19 +10,19 @@
 #include <glm/glm.hpp>
 
 namespace glsl {
-using glm::mat4;
-using glm::vec2;
-using glm::vec3;
-using glm::vec4;
 using glm::dot;
 using glm::length;
 using glm::log;
 using glm::log2;
+using glm::mat4;
 using glm::max;
 using glm::min;
 using glm::normalize;
 using glm::pow;
 using glm::sqrt;
+using glm::vec2;
+using glm::vec3;
+using glm::vec4;
 #include DQJ_GLSL_DE_SOURCE
 #include DQJ_GLSL_SHADING_SOURCE
 }  // namespace glsl

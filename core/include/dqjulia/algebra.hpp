@@ -56,8 +56,7 @@ inline double hypot2(double x, double y) {
 
 /// Hamilton square: (s^2 - |v|^2, 2 s v). Cheaper than q*q and equal to it.
 inline Quat square(const Quat& q) {
-    return Quat(q.w * q.w - q.x * q.x - q.y * q.y - q.z * q.z, 2.0 * q.w * q.x, 2.0 * q.w * q.y,
-                2.0 * q.w * q.z);
+    return Quat(q.w * q.w - q.x * q.x - q.y * q.y - q.z * q.z, 2.0 * q.w * q.x, 2.0 * q.w * q.y, 2.0 * q.w * q.z);
 }
 
 /// sym(a, b) = ab + ba = (2(a0 b0 - a_v.b_v), 2(a0 b_v + b0 a_v)); the cross products cancel.

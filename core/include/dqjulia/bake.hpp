@@ -40,9 +40,9 @@ struct BakeMonitor {
 };
 
 struct BakeOptions {
-    bool dense = false;             ///< evaluate every voxel, skip nothing (for comparisons and tests)
-    std::uint64_t memoryLimit = 0;  ///< refuse above this estimate, in bytes; 0 = defaultMemoryLimit()
-    BakeMonitor* monitor = nullptr; ///< optional live counters
+    bool dense = false;                     ///< evaluate every voxel, skip nothing (for comparisons and tests)
+    std::uint64_t memoryLimit = 0;          ///< refuse above this estimate, in bytes; 0 = defaultMemoryLimit()
+    BakeMonitor* monitor = nullptr;         ///< optional live counters
     Existing existing = Existing::Replace;  ///< bakeVdb: replace an existing file, or keep it and fail
 };
 

@@ -71,10 +71,10 @@ DQJ_API std::size_t batchLanes(bool singlePrecision);
 /// Iterates every point of `points` under `fractal` and writes the results to `out`.
 /// `target` 0 = the best one; otherwise the id of one of batchTargets() (for tests and benchmarks).
 /// Throws std::invalid_argument for a target this CPU cannot run or a null array.
-DQJ_API void evaluateBatch(const Fractal& fractal, const PointBatch<double>& points,
-                           const EscapeBatch<double>& out, std::int64_t target = 0);
-DQJ_API void evaluateBatch(const Fractal& fractal, const PointBatch<float>& points,
-                           const EscapeBatch<float>& out, std::int64_t target = 0);
+DQJ_API void evaluateBatch(const Fractal& fractal, const PointBatch<double>& points, const EscapeBatch<double>& out,
+                           std::int64_t target = 0);
+DQJ_API void evaluateBatch(const Fractal& fractal, const PointBatch<float>& points, const EscapeBatch<float>& out,
+                           std::int64_t target = 0);
 
 /// A batch that owns its arrays: add() points, evaluate(), read the results back by index.
 /// Reuse one per thread: clear() keeps the memory.
@@ -103,8 +103,8 @@ public:
         PointBatch<T> points;
         for (int k = 0; k < 8; ++k) points.coords[k] = start_[k].data();
         points.count = count;
-        evaluateBatch(fractal, points, EscapeBatch<T>{n_.data(), r_.data(), ra_.data(), rb_.data(), de_.data(), trap_.data()},
-                      target);
+        evaluateBatch(fractal, points,
+                      EscapeBatch<T>{n_.data(), r_.data(), ra_.data(), rb_.data(), de_.data(), trap_.data()}, target);
     }
     /// Result `index` of the last evaluate(), as an Escape (exit state left zero).
     Escape escape(std::size_t index) const {

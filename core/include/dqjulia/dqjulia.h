@@ -61,7 +61,7 @@ typedef enum dqj_status {
     DQJ_ERROR_CANCELLED = 5,        /* the progress callback asked to stop */
     DQJ_ERROR_OUT_OF_MEMORY = 6,
     DQJ_ERROR_INTERNAL = 7,
-    DQJ_ERROR_BUSY = 8              /* a call on this context is running (e.g. from its progress callback) */
+    DQJ_ERROR_BUSY = 8 /* a call on this context is running (e.g. from its progress callback) */
 } dqj_status;
 
 /* A short English name for a status ("invalid handle"); never NULL. */
@@ -127,11 +127,11 @@ DQJ_API dqj_status dqj_context_set_slice_axes(dqj_context context, const char* a
  * evaluate functions fill `count` of them), so its size and fields never change; a richer
  * result would be a new struct with new functions. */
 typedef struct dqj_sample {
-    int32_t n;  /* escape iteration; 0 = did not escape within N */
-    double r;   /* norm used for the escape test, at exit */
-    double ra;  /* |a| at exit */
-    double rb;  /* |b| at exit */
-    double de;  /* distance estimate (8-D units); 0 inside, +inf for a zero derivative */
+    int32_t n; /* escape iteration; 0 = did not escape within N */
+    double r;  /* norm used for the escape test, at exit */
+    double ra; /* |a| at exit */
+    double rb; /* |b| at exit */
+    double de; /* distance estimate (8-D units); 0 inside, +inf for a zero derivative */
 } dqj_sample;
 
 /* Evaluates `count` 8-D points (8 doubles each, a then b) into `out` (count samples). */
@@ -148,8 +148,8 @@ typedef int (*dqj_progress_fn)(double fraction, void* user_data);
 
 /* Renders into a caller-owned RGBA8 (sRGB) buffer of `height` rows of `stride` bytes
  * (stride >= 4 * width); width and height override the parameters' render size. */
-DQJ_API dqj_status dqj_render_rgba8(dqj_context context, uint8_t* pixels, uint32_t width, uint32_t height, size_t stride,
-                                    dqj_progress_fn progress, void* user_data);
+DQJ_API dqj_status dqj_render_rgba8(dqj_context context, uint8_t* pixels, uint32_t width, uint32_t height,
+                                    size_t stride, dqj_progress_fn progress, void* user_data);
 /* Renders and writes an image file (.png 8-bit, or as the parameters' output.format says;
  * .exr with depth and normals). The file appears only when complete. */
 DQJ_API dqj_status dqj_render_to_file(dqj_context context, const char* path, dqj_progress_fn progress, void* user_data);

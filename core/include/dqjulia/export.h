@@ -6,13 +6,13 @@
 #define DQJULIA_EXPORT_H
 
 #if defined(_WIN32)
-#  if defined(DQJ_BUILDING_LIBRARY)
-#    define DQJ_API __declspec(dllexport)
-#  else
-#    define DQJ_API __declspec(dllimport)
-#  endif
+#if defined(DQJ_BUILDING_LIBRARY)
+#define DQJ_API __declspec(dllexport)
 #else
-#  define DQJ_API __attribute__((visibility("default")))
+#define DQJ_API __declspec(dllimport)
+#endif
+#else
+#define DQJ_API __attribute__((visibility("default")))
 #endif
 
 #endif

@@ -17,8 +17,9 @@ namespace dqj {
 struct Image {
     int width = 0;
     int height = 0;
-    std::vector<float> rgba;    ///< 4 per pixel: the picture over the background; alpha = fraction of samples that hit
-    std::vector<float> surface; ///< 3 per pixel: the surface alone, premultiplied by alpha (EXR's RGB, for compositing)
+    std::vector<float> rgba;  ///< 4 per pixel: the picture over the background; alpha = fraction of samples that hit
+    std::vector<float>
+        surface;                ///< 3 per pixel: the surface alone, premultiplied by alpha (EXR's RGB, for compositing)
     std::vector<float> depth;   ///< 1 per pixel: distance from the eye to the nearest hit, +inf if none
     std::vector<float> normal;  ///< 3 per pixel: unit surface normal in slice coordinates, 0 if none
 };

@@ -18,10 +18,10 @@ namespace dqj {
 /// One part (real a or dual b) of the constant.
 struct PartReport {
     Quat c;
-    double complexReal = 0.0;      ///< c0
-    double complexImaginary = 0.0; ///< |c_v|
-    bool inMandelbrot = true;      ///< false only when the orbit of 0 provably escapes
-    int mandelbrotEscape = 0;      ///< iteration at which 0 escaped under z^2 + (c0 + |c_v| i); 0 = did not
+    double complexReal = 0.0;       ///< c0
+    double complexImaginary = 0.0;  ///< |c_v|
+    bool inMandelbrot = true;       ///< false only when the orbit of 0 provably escapes
+    int mandelbrotEscape = 0;       ///< iteration at which 0 escaped under z^2 + (c0 + |c_v| i); 0 = did not
     double containmentRadius = 0.0;
 };
 

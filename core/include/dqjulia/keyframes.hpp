@@ -18,15 +18,15 @@ enum class Interpolation {
 };
 struct Keyframe {
     double frame = 1.0;
-    std::vector<double> value;  ///< 8 numbers for fractal.c, 1 otherwise
+    std::vector<double> value;                            ///< 8 numbers for fractal.c, 1 otherwise
     Interpolation interpolation = Interpolation::Linear;  ///< from this key to the next
 };
 /// What a track animates.
 enum class AnimatedValue { Constant, Iterations, Bailout, RotationDegrees };
 struct Track {
     AnimatedValue target = AnimatedValue::Constant;
-    int rotation = 0;             ///< for RotationDegrees: the index into slice.rotations
-    std::vector<Keyframe> keys;   ///< at least one, frames strictly increasing
+    int rotation = 0;            ///< for RotationDegrees: the index into slice.rotations
+    std::vector<Keyframe> keys;  ///< at least one, frames strictly increasing
 };
 
 /// The parameters at `frame`: every animated value replaced by its track's value there (before

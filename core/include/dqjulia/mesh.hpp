@@ -25,9 +25,9 @@
 namespace dqj {
 
 struct Mesh {
-    std::vector<glm::vec3> positions;  ///< slice coordinates
-    std::vector<glm::vec3> normals;    ///< unit, out of the solid; one per vertex
-    std::vector<glm::vec3> colors;     ///< linear RGB per vertex; empty without mesh colours
+    std::vector<glm::vec3> positions;                     ///< slice coordinates
+    std::vector<glm::vec3> normals;                       ///< unit, out of the solid; one per vertex
+    std::vector<glm::vec3> colors;                        ///< linear RGB per vertex; empty without mesh colours
     std::vector<std::array<std::uint32_t, 3>> triangles;  ///< counter-clockwise seen from outside
     std::vector<std::array<std::uint32_t, 4>> quads;      ///< counter-clockwise seen from outside
 

@@ -27,10 +27,10 @@ struct SliceSpec {
 /// A pinhole camera. When `position` is unset the camera frames the bounds from `direction`.
 struct Camera {
     std::optional<glm::dvec3> position;
-    std::optional<glm::dvec3> target;          ///< default: the centre of the bounds
-    glm::dvec3 direction{0.55, 0.45, 1.0};     ///< from target towards the camera, for auto framing
+    std::optional<glm::dvec3> target;       ///< default: the centre of the bounds
+    glm::dvec3 direction{0.55, 0.45, 1.0};  ///< from target towards the camera, for auto framing
     glm::dvec3 up{0.0, 1.0, 0.0};
-    double fovDegrees = 40.0;                  ///< vertical field of view
+    double fovDegrees = 40.0;  ///< vertical field of view
 };
 
 /// A directional light: `direction` points from the surface towards the light.
@@ -61,11 +61,11 @@ enum class NormalMethod { Auto, CentralDifferences, Analytic };
 struct RenderSettings {
     int width = 640;
     int height = 480;
-    int samples = 2;           ///< anti-aliasing: samples x samples rays per pixel
-    double stepFactor = 0.9;   ///< fraction of the distance estimate taken per step
-    double maxStep = 0.25;     ///< largest step, in slice units
+    int samples = 2;          ///< anti-aliasing: samples x samples rays per pixel
+    double stepFactor = 0.9;  ///< fraction of the distance estimate taken per step
+    double maxStep = 0.25;    ///< largest step, in slice units
     int maxSteps = 400;
-    double detail = 1.0;       ///< hit threshold in pixel footprints (smaller = finer)
+    double detail = 1.0;                        ///< hit threshold in pixel footprints (smaller = finer)
     NormalMethod normals = NormalMethod::Auto;  ///< auto: analytic for dual, central differences otherwise
     glm::dvec3 backgroundTop{0.30, 0.36, 0.45};
     glm::dvec3 backgroundBottom{0.06, 0.06, 0.08};
@@ -93,8 +93,8 @@ struct BakeSettings {
     std::optional<Box> bounds;  ///< default: the cube around the render bounds' sphere, clipped to the sphere
     double bandWidth = 3.0;     ///< half width of the level set's narrow band, in voxels
     std::vector<BakeGrid> grids{BakeGrid::Surface, BakeGrid::Density};
-    double adaptivity = 0.0;    ///< mesh adaptivity 0..1 (OpenVDB volumeToMesh): 0 = uniform quads
-    bool meshColors = true;     ///< vertex colours from the material's colouring
+    double adaptivity = 0.0;  ///< mesh adaptivity 0..1 (OpenVDB volumeToMesh): 0 = uniform quads
+    bool meshColors = true;   ///< vertex colours from the material's colouring
 };
 
 struct Params {

@@ -33,11 +33,11 @@ DQJ_API std::string_view povrayInclude();
 /// and stored as fractions of maxDistance: 0 inside the finite-N set, 1 at maxDistance or more
 /// (and for a zero derivative). Sample (i, j, k) sits at POV-Ray point lower + spacing * (i, j, k).
 struct DensityGrid {
-    int resolution = 0;          ///< samples along each axis
-    glm::dvec3 lower{0.0};       ///< POV-Ray coordinates of sample (0, 0, 0)
-    double spacing = 0.0;        ///< distance between neighbouring samples, scene units
-    double maxDistance = 0.0;    ///< the distance a stored 1 stands for, scene units
-    std::vector<float> values;   ///< resolution^3 fractions in [0, 1], x fastest, then y, then z
+    int resolution = 0;         ///< samples along each axis
+    glm::dvec3 lower{0.0};      ///< POV-Ray coordinates of sample (0, 0, 0)
+    double spacing = 0.0;       ///< distance between neighbouring samples, scene units
+    double maxDistance = 0.0;   ///< the distance a stored 1 stands for, scene units
+    std::vector<float> values;  ///< resolution^3 fractions in [0, 1], x fastest, then y, then z
     /// Bound on the gradient of the grid's trilinear interpolation, in stored units per scene
     /// unit (from each cell's largest edge differences along each axis): the isosurface's max_gradient.
     double maxGradient = 0.0;
@@ -78,7 +78,7 @@ struct PovrayWriteOptions {
     bool df3 = false;         ///< also bake <scene>.df3 and write <scene>_df3.pov drawing it
     int df3Resolution = 128;
     int df3Bits = 16;
-    std::string sourceName;   ///< for the scenes' header comment
+    std::string sourceName;                 ///< for the scenes' header comment
     Existing existing = Existing::Replace;  ///< replace existing files, or keep them and fail
 };
 
@@ -90,7 +90,8 @@ struct PovrayFiles {
     std::string df3Scene;  ///< <scene>_df3.pov, drawing the grid
     std::string include;   ///< dqjulia.inc beside the scene
 };
-DQJ_API PovrayFiles povrayFiles(const Params& params, const std::string& scenePath, const PovrayWriteOptions& options = {});
+DQJ_API PovrayFiles povrayFiles(const Params& params, const std::string& scenePath,
+                                const PovrayWriteOptions& options = {});
 
 /// Writes the files of povrayFiles(), each through a temporary file renamed into place (the
 /// include only if it is missing or differs from povrayInclude()). Every text is built and the

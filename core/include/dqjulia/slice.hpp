@@ -30,8 +30,7 @@ struct PlaneRotation {
 
 struct Slice {
     Vec8 origin{};
-    std::array<Vec8, 3> axes{Vec8{1, 0, 0, 0, 0, 0, 0, 0}, Vec8{0, 1, 0, 0, 0, 0, 0, 0},
-                             Vec8{0, 0, 1, 0, 0, 0, 0, 0}};
+    std::array<Vec8, 3> axes{Vec8{1, 0, 0, 0, 0, 0, 0, 0}, Vec8{0, 1, 0, 0, 0, 0, 0, 0}, Vec8{0, 0, 1, 0, 0, 0, 0, 0}};
 
     DualQuat map(const glm::dvec3& p) const {
         DualQuat z;
