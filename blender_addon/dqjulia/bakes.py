@@ -264,17 +264,21 @@ def build_mesh(context, source, data):
     mesh = bpy.data.meshes.new(name)
     material = None
     try:
-        vertices, triangles = data.vertex_count, data.triangle_count
+        vertices, quads, triangles = data.vertex_count, data.quad_count, data.triangle_count
+        faces = quads + triangles
         mesh.vertices.add(vertices)
         mesh.vertices.foreach_set("co", data.positions)
-        mesh.loops.add(3 * triangles)
-        mesh.loops.foreach_set("vertex_index", data.triangles)
-        mesh.polygons.add(triangles)
-        # loop_total is read-only since 3.6: Blender derives it from the next face's loop_start.
-        mesh.polygons.foreach_set("loop_start", array.array("i", range(0, 3 * triangles, 3)))
+        mesh.loops.add(4 * quads + 3 * triangles)
+        mesh.loops.foreach_set("vertex_index", data.quads + data.triangles)
+        mesh.polygons.add(faces)
+        # The core's quads stay quads (then its triangles). loop_total is read-only since 3.6:
+        # Blender derives it from the next face's loop_start.
+        starts = array.array("i", range(0, 4 * quads, 4))
+        starts.extend(range(4 * quads, 4 * quads + 3 * triangles, 3))
+        mesh.polygons.foreach_set("loop_start", starts)
         if not bpy.types.MeshPolygon.bl_rna.properties["loop_total"].is_readonly:  # Blender 3.4 - 3.5
-            mesh.polygons.foreach_set("loop_total", array.array("i", [3]) * triangles)
-        mesh.polygons.foreach_set("use_smooth", array.array("b", [1]) * triangles)
+            mesh.polygons.foreach_set("loop_total", array.array("i", [4]) * quads + array.array("i", [3]) * triangles)
+        mesh.polygons.foreach_set("use_smooth", array.array("b", [1]) * faces)
         mesh.update(calc_edges=True)
         if hasattr(mesh, "use_auto_smooth"):  # Blender < 4.1: custom normals need auto smooth
             mesh.use_auto_smooth = True

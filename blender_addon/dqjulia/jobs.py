@@ -21,12 +21,14 @@ _lock = threading.Lock()
 
 
 class MeshData:
-    """A mesh copied out of the core: flat arrays ready for foreach_set (no bpy)."""
+    """A mesh copied out of the core: flat arrays ready for foreach_set (no bpy). Faces as the
+    core made them: quads first, then triangles."""
 
-    def __init__(self, positions, normals, colors, triangles):
+    def __init__(self, positions, normals, colors, quads, triangles):
         self.positions = positions  # array('f'), 3 a vertex
         self.normals = normals  # array('f'), 3 a vertex
         self.colors = colors  # array('f'), 3 a vertex, or None
+        self.quads = quads  # array('i'), 4 a quad
         self.triangles = triangles  # array('i'), 3 a triangle
 
     @property
@@ -34,8 +36,16 @@ class MeshData:
         return len(self.positions) // 3
 
     @property
+    def quad_count(self):
+        return len(self.quads) // 4
+
+    @property
     def triangle_count(self):
         return len(self.triangles) // 3
+
+    @property
+    def face_count(self):
+        return self.quad_count + self.triangle_count
 
 
 def _as_array(typecode, ctypes_array):
@@ -75,11 +85,12 @@ class MeshTask:
 
     def run(self, context, progress):
         self.warning = context.mesh_compute(progress)
-        positions, normals, colors, triangles = context.mesh_copy(colors=self.colors)
+        positions, normals, colors, quads, triangles = context.mesh_faces(colors=self.colors)
         return MeshData(
             _as_array("f", positions),
             _as_array("f", normals),
             _as_array("f", colors) if colors is not None else None,
+            _as_array("i", quads),
             _as_array("i", triangles),
         )
 

@@ -170,6 +170,12 @@ _SIGNATURES = {
         ],
         (FEATURE_MESH,),
     ),
+    "dqj_mesh_get_face_counts": (_status, [_handle, _size_p, _size_p], (FEATURE_MESH,)),
+    "dqj_mesh_copy_faces": (
+        _status,
+        [_handle, ctypes.POINTER(ctypes.c_uint32), ctypes.c_size_t, ctypes.POINTER(ctypes.c_uint32), ctypes.c_size_t],
+        (FEATURE_MESH,),
+    ),
     "dqj_mesh_write": (_status, [_handle, ctypes.c_char_p], (FEATURE_MESH,)),
     "dqj_bake_get_stats": (_status, [_handle, ctypes.POINTER(BakeStats)], _BAKE),
 }
@@ -531,6 +537,29 @@ class Context:
             function(self.handle, positions, normals, colours, vertex_count, triangles, triangle_count), "mesh copy"
         )
         return positions, normals, colours, triangles
+
+    def mesh_faces(self, colors=True):
+        """The context's mesh with its faces as the core made them: (positions, normals, colors or
+        None, quads, triangles) as ctypes arrays; 4 and 3 uint32 indices a face."""
+        vertex_count, _triangle_count = self.mesh_sizes()
+        positions = (ctypes.c_float * (3 * vertex_count))()
+        normals = (ctypes.c_float * (3 * vertex_count))()
+        colours = (ctypes.c_float * (3 * vertex_count))() if colors else None
+        self.check(
+            _function("dqj_mesh_copy")(self.handle, positions, normals, colours, vertex_count, None, 0), "mesh copy"
+        )
+        quad_count, triangle_count = ctypes.c_size_t(0), ctypes.c_size_t(0)
+        self.check(
+            _function("dqj_mesh_get_face_counts")(self.handle, ctypes.byref(quad_count), ctypes.byref(triangle_count)),
+            "mesh face counts",
+        )
+        quads = (ctypes.c_uint32 * (4 * quad_count.value))()
+        triangles = (ctypes.c_uint32 * (3 * triangle_count.value))()
+        self.check(
+            _function("dqj_mesh_copy_faces")(self.handle, quads, quad_count.value, triangles, triangle_count.value),
+            "mesh faces",
+        )
+        return positions, normals, colours, quads, triangles
 
     def mesh_write(self, path):
         self.check(_function("dqj_mesh_write")(self.handle, os.fsencode(path)), "mesh write")

@@ -438,12 +438,14 @@ class DQJULIA_OT_bake_mesh(_BakeOperator, bpy.types.Operator):
 
     def build(self, context, obj, job):
         data = job.results[0]
-        if data.triangle_count == 0:
+        if data.face_count == 0:
             raise RuntimeError(
-                "the surface has no triangles at this resolution%s" % ("; " + job.warnings[0] if job.warnings else "")
+                "the surface has no faces at this resolution%s" % ("; " + job.warnings[0] if job.warnings else "")
             )
         mesh = bakes.build_mesh(context, obj, data)
-        return "Baked %s: %d vertices, %d triangles" % (mesh.name, data.vertex_count, data.triangle_count)
+        return "Baked %s: %d vertices, %d quads, %d triangles" % (
+            mesh.name, data.vertex_count, data.quad_count, data.triangle_count
+        )
 
 
 def estimate_sequence(document, frames, folder):

@@ -515,8 +515,10 @@ dqj_status dqj_mesh_copy(dqj_context context, float* positions, float* normals, 
     return guarded(context, [&](dqj_context_t& self) {
         const dqj::Mesh& mesh = self.mesh;
         const size_t vertices = mesh.positions.size();
-        if (vertices != 0 && (!positions || !triangles)) return invalidArgument(self, "positions or triangles is NULL");
-        if (vertexCapacity < vertices || triangleCapacity < mesh.triangleCount())
+        const bool vertexOnly = !triangles && triangleCapacity == 0;  // faces from dqj_mesh_copy_faces
+        if (vertices != 0 && (!positions || (!triangles && !vertexOnly)))
+            return invalidArgument(self, "positions or triangles is NULL");
+        if (vertexCapacity < vertices || (!vertexOnly && triangleCapacity < mesh.triangleCount()))
             return invalidArgument(self, "buffers too small: the mesh has " + std::to_string(vertices) +
                                              " vertices and " + std::to_string(mesh.triangleCount()) +
                                              " triangles; capacities are " + std::to_string(vertexCapacity) + " and " +
@@ -530,8 +532,36 @@ dqj_status dqj_mesh_copy(dqj_context context, float* positions, float* normals, 
                 if (colors) colors[3 * index + axis] = mesh.colors[index][axis];
             }
         }
+        if (vertexOnly) return DQJ_OK;
         const std::vector<std::uint32_t> indices = mesh.triangulated();
         std::copy(indices.begin(), indices.end(), triangles);
+        return DQJ_OK;
+    });
+}
+
+dqj_status dqj_mesh_get_face_counts(dqj_context context, size_t* outQuadCount, size_t* outTriangleCount) {
+    return guarded(context, [&](dqj_context_t& self) {
+        if (outQuadCount) *outQuadCount = self.mesh.quads.size();
+        if (outTriangleCount) *outTriangleCount = self.mesh.triangles.size();
+        return DQJ_OK;
+    });
+}
+
+dqj_status dqj_mesh_copy_faces(dqj_context context, uint32_t* quads, size_t quadCapacity, uint32_t* triangles,
+                               size_t triangleCapacity) {
+    return guarded(context, [&](dqj_context_t& self) {
+        const dqj::Mesh& mesh = self.mesh;
+        if ((!quads && !mesh.quads.empty()) || (!triangles && !mesh.triangles.empty()))
+            return invalidArgument(self, "quads or triangles is NULL but the mesh has such faces");
+        if (quadCapacity < mesh.quads.size() || triangleCapacity < mesh.triangles.size())
+            return invalidArgument(self, "buffers too small: the mesh has " + std::to_string(mesh.quads.size()) +
+                                             " quads and " + std::to_string(mesh.triangles.size()) +
+                                             " triangles; capacities are " + std::to_string(quadCapacity) + " and " +
+                                             std::to_string(triangleCapacity));
+        for (std::size_t face = 0; face < mesh.quads.size(); ++face)
+            std::copy(mesh.quads[face].begin(), mesh.quads[face].end(), quads + 4 * face);
+        for (std::size_t face = 0; face < mesh.triangles.size(); ++face)
+            std::copy(mesh.triangles[face].begin(), mesh.triangles[face].end(), triangles + 3 * face);
         return DQJ_OK;
     });
 }

@@ -798,18 +798,22 @@ def case_bake_mesh():
     mesh = mesh_object.data
     with native.Context(props.to_document(s)) as context:
         context.mesh_compute()
-        vertex_count, triangle_count = context.mesh_sizes()
-        positions, normals, _colors, triangles = context.mesh_copy()
+        vertex_count, _triangle_count = context.mesh_sizes()
+        positions, normals, _colors, quads, triangles = context.mesh_faces()
+    quad_count, triangle_count = len(quads) // 4, len(triangles) // 3
     check(
-        len(mesh.vertices) == vertex_count > 100 and len(mesh.polygons) == triangle_count > 100,
-        "%d vertices and %d triangles, as the core's mesh" % (len(mesh.vertices), len(mesh.polygons)),
+        len(mesh.vertices) == vertex_count > 100 and len(mesh.polygons) == quad_count + triangle_count > 100,
+        "%d vertices and %d faces, as the core's mesh" % (len(mesh.vertices), len(mesh.polygons)),
     )
     totals = array.array("i", [0]) * len(mesh.polygons)
     mesh.polygons.foreach_get("loop_total", totals)
-    check(set(totals) == {3} and len(mesh.loops) == 3 * triangle_count, "all faces are triangles")
+    check(
+        list(totals) == [4] * quad_count + [3] * triangle_count and quad_count > 0.9 * len(mesh.polygons),
+        "the core's quads stay quads: %d quads, %d triangles" % (quad_count, triangle_count),
+    )
     loop_vertices = array.array("i", [0]) * len(mesh.loops)
     mesh.loops.foreach_get("vertex_index", loop_vertices)
-    check(list(loop_vertices) == list(triangles), "the faces are the core's triangles, in order")
+    check(list(loop_vertices) == list(quads) + list(triangles), "the faces are the core's, in order")
     check(mesh.validate(verbose=False) is False, "Mesh.validate finds nothing to fix")
     check(mesh.has_custom_normals, "it carries the core's normals (custom split normals)")
     if hasattr(mesh, "calc_normals_split"):

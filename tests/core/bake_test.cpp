@@ -461,6 +461,29 @@ TEST_F(BakeCApi, MeshIntoCallerBuffers) {
     for (const auto& [edge, count] : uses) ASSERT_EQ(count, 2);
     EXPECT_GT(stats.voxels_evaluated, 0u);
     EXPECT_EQ(stats.voxels_dense, 24u * 24u * 24u);
+    // The faces as the core made them: every quad and triangle, and the triangulated copy
+    // above is the same faces split.
+    size_t quads = 0, faceTriangles = 0;
+    ASSERT_EQ(dqj_mesh_get_face_counts(context_, &quads, &faceTriangles), DQJ_OK);
+    EXPECT_EQ(2 * quads + faceTriangles, triangles);
+    EXPECT_GT(quads, faceTriangles);
+    std::vector<uint32_t> quadIndices(4 * quads), triangleIndices(3 * faceTriangles + 3);
+    EXPECT_EQ(dqj_mesh_copy_faces(context_, quadIndices.data(), quads - 1, triangleIndices.data(), faceTriangles),
+              DQJ_ERROR_INVALID_ARGUMENT);
+    EXPECT_EQ(dqj_mesh_copy_faces(context_, nullptr, 0, triangleIndices.data(), faceTriangles),
+              quads ? DQJ_ERROR_INVALID_ARGUMENT : DQJ_OK);
+    ASSERT_EQ(dqj_mesh_copy_faces(context_, quadIndices.data(), quads, triangleIndices.data(), faceTriangles), DQJ_OK);
+    EXPECT_TRUE(std::equal(triangleIndices.begin(), triangleIndices.begin() + 3 * faceTriangles, indices.begin()));
+    for (size_t face = 0; face < quads; ++face) {  // after the triangles, split along the 0-2 diagonal
+        const uint32_t* q = &quadIndices[4 * face];
+        const std::vector<uint32_t> split{q[0], q[1], q[2], q[0], q[2], q[3]};
+        const auto first = indices.begin() + 3 * faceTriangles + 6 * face;
+        const std::vector<uint32_t> copied(first, first + 6);
+        ASSERT_EQ(copied, split) << "quad " << face;
+    }
+    std::vector<float> vertexOnly(3 * vertices);
+    ASSERT_EQ(dqj_mesh_copy(context_, vertexOnly.data(), nullptr, nullptr, vertices, nullptr, 0), DQJ_OK);
+    EXPECT_EQ(vertexOnly, positions);
     ASSERT_EQ(dqj_mesh_write(context_, path("c.ply").c_str()), DQJ_OK);
     EXPECT_TRUE(fs::exists(path("c.ply")));
     EXPECT_EQ(dqj_mesh_write(context_, path("c.stl").c_str()), DQJ_ERROR_PARAMETERS);

@@ -191,11 +191,23 @@ DQJ_API dqj_status dqj_mesh_get_sizes(dqj_context context, size_t* out_vertex_co
  *   normals    3 floats a vertex, unit, pointing out of the solid; NULL to skip;
  *   colors     3 floats a vertex, linear RGB from the material's colouring; NULL to skip (and
  *              NULL is required when bake.mesh_colors was false: the mesh then has none);
- *   triangles  3 vertex indices a triangle, counter-clockwise seen from outside.
+ *   triangles  3 vertex indices a triangle, counter-clockwise seen from outside (every face as
+ *              triangles); NULL with triangle_capacity 0 to copy the vertices only (for
+ *              dqj_mesh_copy_faces).
  * vertex_capacity and triangle_capacity are the buffers' sizes in vertices and triangles;
  * too small gives DQJ_ERROR_INVALID_ARGUMENT and copies nothing. */
 DQJ_API dqj_status dqj_mesh_copy(dqj_context context, float* positions, float* normals, float* colors,
                                  size_t vertex_capacity, uint32_t* triangles, size_t triangle_capacity);
+/* The faces of the context's mesh as the core made them: quads, and triangles (with adaptivity
+ * or where a quad would repeat a vertex). 0 and 0 before the first dqj_mesh_compute. Either
+ * pointer may be NULL. */
+DQJ_API dqj_status dqj_mesh_get_face_counts(dqj_context context, size_t* out_quad_count, size_t* out_triangle_count);
+/* Copies the faces into caller-owned buffers sized by dqj_mesh_get_face_counts: quads 4 vertex
+ * indices each, triangles 3 each, counter-clockwise seen from outside (vertices from dqj_mesh_copy).
+ * A buffer may be NULL when its count is 0; too small gives DQJ_ERROR_INVALID_ARGUMENT and
+ * copies nothing. */
+DQJ_API dqj_status dqj_mesh_copy_faces(dqj_context context, uint32_t* quads, size_t quad_capacity, uint32_t* triangles,
+                                       size_t triangle_capacity);
 /* Writes the context's mesh to `path`: .ply (binary, with normals and colours) or .obj. Same
  * all-or-nothing file behaviour as dqj_bake_vdb. */
 DQJ_API dqj_status dqj_mesh_write(dqj_context context, const char* path);
