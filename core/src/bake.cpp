@@ -21,6 +21,7 @@
 #include <openvdb/io/File.h>
 #include <openvdb/tools/LevelSetRebuild.h>
 #include <openvdb/tools/LevelSetUtil.h>
+#include <openvdb/tools/Morphology.h>
 
 #include "atomic_file.hpp"
 #include "level_set.hpp"
@@ -67,16 +68,44 @@ MemoryModel bakeMemoryModel(const BakeSettings& bake) {
     return model;
 }
 
-/// The attribute grids ("color", "trap", "iterations") on the level set's active voxels: one
-/// fractal evaluation per voxel of the narrow band; colour and smooth count from coloring.hpp.
+/// The voxels the attribute grids cover: the level set's narrow band and the inside below it to
+/// bake.color_depth of the bake's largest side (`resolution` voxels), so a volume shows its
+/// colours through the depth light reaches, not a thin shell over black.
+openvdb::MaskTree attributeVoxels(const openvdb::FloatGrid& surface, const BakeSettings& bake) {
+    openvdb::MaskTree mask(surface.tree(), false, openvdb::TopologyCopy());
+    const int depth = int(std::ceil(bake.colorDepth * bake.resolution));
+    const int inside = int(std::ceil(bake.bandWidth));  // what the band already covers
+    if (depth > inside) {
+        // 26-neighbour steps: at least `depth` voxels deep in every direction (up to sqrt 3 times
+        // that along the diagonals).
+        openvdb::tools::dilateActiveValues(mask, depth - inside, openvdb::tools::NN_FACE_EDGE_VERTEX,
+                                           openvdb::tools::IGNORE_TILES);
+        // Keep the band, and of the rest only the inside (negative distance): never the air.
+        std::vector<openvdb::MaskTree::LeafNodeType*> leaves;
+        mask.getNodes(leaves);
+        for (auto* leaf : leaves) {
+            openvdb::tree::ValueAccessor<const openvdb::FloatTree> accessor(surface.tree());
+            const auto on = leaf->getValueMask();  // a copy: voxels are switched off as they are visited
+            for (auto bit = on.beginOn(); bit; ++bit) {
+                const openvdb::Coord ijk = leaf->offsetToGlobalCoord(bit.pos());
+                if (!accessor.isValueOn(ijk) && !(accessor.getValue(ijk) < 0.0f)) leaf->setValueOff(bit.pos());
+            }
+        }
+    }
+    return mask;
+}
+
+/// The attribute grids ("color", "trap", "iterations") on attributeVoxels(): one fractal
+/// evaluation a voxel; colour and smooth count from coloring.hpp.
 void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, const ProgressCallback& progress,
                        BakeStats& stats, openvdb::GridPtrVec& grids) {
     const bool color = hasGrid(params.bake, BakeGrid::Color);
     const bool trap = hasGrid(params.bake, BakeGrid::Trap);
     const bool iterations = hasGrid(params.bake, BakeGrid::Iterations);
     if (!color && !trap && !iterations) return;
-    std::vector<const FloatLeaf*> leaves;
-    surface.tree().getNodes(leaves);
+    const openvdb::MaskTree voxels = attributeVoxels(surface, params.bake);
+    std::vector<const openvdb::MaskTree::LeafNodeType*> leaves;
+    voxels.getNodes(leaves);
     std::vector<std::unique_ptr<ColorLeaf>> colorLeaves(color ? leaves.size() : 0);
     std::vector<std::unique_ptr<FloatLeaf>> trapLeaves(trap ? leaves.size() : 0);
     std::vector<std::unique_ptr<FloatLeaf>> iterationLeaves(iterations ? leaves.size() : 0);
@@ -84,7 +113,7 @@ void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, 
     const double h = surface.voxelSize()[0];
     std::atomic<std::uint64_t> evaluated{0};
     parallelForWithProgress(leaves.size(), progress, [&](std::size_t index, const std::atomic<bool>& stop) {
-        const FloatLeaf& leaf = *leaves[index];
+        const auto& leaf = *leaves[index];
         auto colorLeaf = color ? std::make_unique<ColorLeaf>(leaf.origin(), openvdb::Vec3s(0.0f), false) : nullptr;
         auto trapLeaf = trap ? std::make_unique<FloatLeaf>(leaf.origin(), 0.0f, false) : nullptr;
         auto iterationLeaf = iterations ? std::make_unique<FloatLeaf>(leaf.origin(), 0.0f, false) : nullptr;

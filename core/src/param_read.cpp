@@ -285,6 +285,7 @@ void readBake(ObjectReader reader, BakeSettings& bake) {
     }
     reader.read("adaptivity", bake.adaptivity);
     reader.read("mesh_colors", bake.meshColors);
+    reader.read("color_depth", bake.colorDepth);
     reader.finish();
 }
 

@@ -95,6 +95,7 @@ std::string toJson(const Params& params) {
     bakeJson["grids"] = grids;
     bakeJson["adaptivity"] = bake.adaptivity;
     bakeJson["mesh_colors"] = bake.meshColors;
+    bakeJson["color_depth"] = bake.colorDepth;
     document["bake"] = bakeJson;
     json::OrderedJson animation = json::OrderedJson::object();
     for (const Track& track : params.animation) {

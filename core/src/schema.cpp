@@ -356,6 +356,10 @@ const Field kFields[] = {
     {"bake.grids", Type::ChoiceSet, "Grids", "The grids a volume bake writes", 1, 5, false, false, 1, 5, kGrids},
     {"bake.adaptivity", Type::Number, "Adaptivity", "Mesh adaptivity: 0 = uniform quads, more = fewer faces", 0, 1},
     {"bake.mesh_colors", Type::Boolean, "Vertex colours", "Vertex colours from the material's colouring"},
+    {"bake.color_depth", Type::Number, "Colour depth",
+     "How deep below the surface the colour, trap and iteration grids reach, as a fraction of the bake's largest side "
+     "(at least the band); a volume's material should absorb the light within it",
+     0, 1, false, false, 0, 0.1},
 
     {"animation", Type::Animation, "Animation",
      "Keyframes of the animatable keys: {\"fractal.c\": [{\"frame\": 1, \"value\": [...], \"interpolation\": "

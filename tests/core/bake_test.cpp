@@ -114,6 +114,45 @@ TEST_F(Bake, TheFileHoldsNamedGridsOfTheRightClassAndTransform) {
     EXPECT_EQ(stats.dense, 48u * 48u * 48u);
 }
 
+TEST_F(Bake, ColoursReachBelowTheSurfaceToTheColourDepth) {
+    // The unit ball at 100 voxels with bake.color_depth 0.08: colour on every voxel of the band
+    // and on every inside voxel to 8 voxels deep (dilated in 26-neighbour steps: up to 3 + 5 sqrt 3
+    // along the diagonals), none deeper and none in the air beyond the band.
+    Params params = unitBall(100);
+    params.bake.grids = {BakeGrid::Surface, BakeGrid::Density, BakeGrid::Color};
+    params.bake.colorDepth = 0.08;
+    const BakeStats stats = bakeVdb(params, path("c.vdb"));
+    auto grids = readGrids(path("c.vdb"));
+    auto surface = openvdb::gridPtrCast<openvdb::FloatGrid>(grids["surface"]);
+    auto color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(grids["color"]);
+    ASSERT_TRUE(surface && color);
+    const double h = stats.voxelSize;
+    auto colours = color->getConstAccessor();
+    std::size_t inside = 0, coloured = 0, tooDeep = 0, inAir = 0;
+    for (int i = -60; i <= 60; ++i)
+        for (int j = -60; j <= 60; j += 3)
+            for (int k = -60; k <= 60; k += 3) {
+                const double depth = 1.0 - glm::length(glm::dvec3(i, j, k) * h);  // inside the ball: > 0
+                const bool on = colours.isValueOn(openvdb::Coord(i, j, k));
+                if (depth > 0.5 * h && depth < 7.0 * h) {
+                    ++inside;
+                    coloured += on && colours.getValue(openvdb::Coord(i, j, k)).length() > 0.0f;
+                }
+                if (depth > 12.0 * h) tooDeep += on;
+                if (depth < -4.0 * h) inAir += on;
+            }
+    EXPECT_GT(inside, 1000u);
+    EXPECT_EQ(coloured, inside) << "inside voxels within the colour depth without colour";
+    EXPECT_EQ(tooDeep, 0u);
+    EXPECT_EQ(inAir, 0u);
+    // The default depth (0.02 of 100 = 2 voxels) is less than the band: the band alone.
+    params.bake.colorDepth = 0.02;
+    bakeVdb(params, path("d.vdb"));
+    auto band = openvdb::gridPtrCast<openvdb::Vec3SGrid>(readGrids(path("d.vdb"))["color"]);
+    EXPECT_EQ(band->activeVoxelCount(), surface->activeVoxelCount());
+    EXPECT_GT(color->activeVoxelCount(), 3 * band->activeVoxelCount() / 2);  // the band is 6 voxels thick
+}
+
 TEST_F(Bake, TheSurfaceOfCZeroIsTheUnitSphereWithinAVoxel) {
     const Params params = unitBall(64);
     const BakeStats stats = bakeVdb(params, path("ball.vdb"));
