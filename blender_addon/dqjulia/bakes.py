@@ -24,10 +24,14 @@ import uuid
 import bpy
 from bpy.app.handlers import persistent
 
+from . import preview
+
 ADDON_DIR = os.path.dirname(os.path.abspath(__file__))
 BAKE_KIND = "dqjulia_bake"  # custom property on baked objects: "volume", "mesh", "sequence"
 BAKE_FILES = "dqjulia_files"  # custom property: the files or folder the baked object reads (as stored)
-VOLUME_DENSITY_SCALE = 10.0  # the fog is 0..1; this makes the set read as solid-ish smoke
+# The volume material's density: light falls to e^-4 (2 %) within the colour grid's depth
+# (bake.color_depth of the bake's side), so a render shows the colours, not the black beneath.
+VISIBLE_OPTICAL_DEPTH = 4.0
 DEFAULT_CACHE = "//dqjulia_cache"  # beside the .blend
 
 # The bake files made since the .blend was last saved or opened (absolute, normalised): the
@@ -184,10 +188,22 @@ def principled_volume_material(name):
     return material, volume
 
 
-def volume_material(name, grid_names):
+def volume_density(source):
+    """The density scale of a DQ Julia object's volume material (and its OSL volume's): the fog
+    is 0..1; this makes light fall to e^-4 within bake.color_depth of the bake's side."""
+    s = source.dqjulia
+    if s.bake_bounds_auto:
+        bounds = preview.state_for(source).bounds
+        side = 2.0 * (bounds[1] if bounds else 1.0)
+    else:
+        side = max(high - low for low, high in zip(s.bake_bounds_min, s.bake_bounds_max))
+    return VISIBLE_OPTICAL_DEPTH / max(1e-6, s.bake_color_depth * side)
+
+
+def volume_material(name, grid_names, density=10.0):
     material, volume = principled_volume_material(name)
     tree = material.node_tree
-    volume.inputs["Density"].default_value = VOLUME_DENSITY_SCALE
+    volume.inputs["Density"].default_value = density
     if "Density Attribute" in volume.inputs:
         volume.inputs["Density Attribute"].default_value = "density"
     if "color" in grid_names:
@@ -234,7 +250,7 @@ def build_volume(context, source, path, sequence=None):
             volume.frame_duration = count
             volume.frame_offset = first - 1
             volume.sequence_mode = "CLIP"
-        material = volume_material(name, names)
+        material = volume_material(name, names, volume_density(source))
         volume.materials.append(material)
         files = [sequence[2]] if sequence else [path]
         return _replace(context, source, kind, name, volume, files)

@@ -135,7 +135,7 @@ def add_volume(context, source):
     scale = tree.nodes.new("ShaderNodeMath")
     scale.operation = "MULTIPLY"
     scale.location = (-150, 0)
-    scale.inputs[1].default_value = bakes.VOLUME_DENSITY_SCALE
+    scale.inputs[1].default_value = bakes.volume_density(source)
     tree.links.new(script.outputs["Density"], scale.inputs[0])
     tree.links.new(scale.outputs["Value"], volume.inputs["Density"])
     sync_node(script, source)

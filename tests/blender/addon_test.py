@@ -55,7 +55,10 @@ RENDER_BAKE_RESOLUTION = 64  # the render case's bakes
 # below a pixel (IoU 0.956 - 0.978). It bakes in about 2 s.
 OSL_BAKE_RESOLUTION = 160
 MESH_VOLUME_IOU = 0.90  # baked mesh against baked volume (measured 0.95 in 4.2 - 5.0)
-OSL_VOLUME_IOU = 0.95  # OSL volume against baked volume (the same density, computed twice)
+# OSL volume against baked volume (the same density, computed twice). At the materials'
+# density (light falls to 2 % within the colour depth) the baked fog's ramp over the band's inner
+# voxels shows more than at the old density 10: measured 0.943 in 4.2 - 5.0 at 160^3 (was 0.956).
+OSL_VOLUME_IOU = 0.93
 
 CASES = [
     "library",

@@ -92,7 +92,7 @@ struct BakeSettings {
     int resolution = 256;       ///< voxels across the largest side of the bounds
     std::optional<Box> bounds;  ///< default: the cube around the render bounds' sphere, clipped to the sphere
     double bandWidth = 3.0;     ///< half width of the level set's narrow band, in voxels
-    std::vector<BakeGrid> grids{BakeGrid::Surface, BakeGrid::Density};
+    std::vector<BakeGrid> grids{BakeGrid::Surface, BakeGrid::Density, BakeGrid::Color};
     double adaptivity = 0.0;  ///< mesh adaptivity 0..1 (OpenVDB volumeToMesh): 0 = uniform quads
     bool meshColors = true;   ///< vertex colours from the material's colouring
     /// How deep inside the attribute grids (color, trap, iterations) reach, as a fraction of the
