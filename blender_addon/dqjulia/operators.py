@@ -444,7 +444,10 @@ class DQJULIA_OT_bake_mesh(_BakeOperator, bpy.types.Operator):
             )
         mesh = bakes.build_mesh(context, obj, data)
         return "Baked %s: %d vertices, %d quads, %d triangles" % (
-            mesh.name, data.vertex_count, data.quad_count, data.triangle_count
+            mesh.name,
+            data.vertex_count,
+            data.quad_count,
+            data.triangle_count,
         )
 
 
