@@ -41,6 +41,8 @@ void checkNumber(const Field& field, const Json& value, const std::string& key, 
                  formatNumber(x));
 }
 
+}  // namespace
+
 void checkVector(const Field& field, const Json& value, const std::string& key, const std::string& prefix,
                  std::size_t size) {
     if (!value.is_array() || value.size() != size)
@@ -48,6 +50,8 @@ void checkVector(const Field& field, const Json& value, const std::string& key, 
     for (std::size_t index = 0; index < size; ++index)
         checkNumber(field, value[index], key + "[" + std::to_string(index) + "]", prefix);
 }
+
+namespace {
 
 void checkCount(const Field& field, const Json& value, const std::string& key, const std::string& prefix,
                 const std::string& what) {

@@ -15,6 +15,10 @@ namespace dqj::detail {
 /// key + ": " + what is wrong and what is allowed).
 void checkValue(const schema::Field& field, const json::Json& value, const std::string& key, const std::string& prefix);
 
+/// Checks that `value` is an array of `size` numbers, each within the field's range.
+void checkVector(const schema::Field& field, const json::Json& value, const std::string& key, const std::string& prefix,
+                 std::size_t size);
+
 /// checkValue for every key of a whole document, as toJson writes it.
 void checkDocument(const json::Json& document);
 

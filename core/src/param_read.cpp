@@ -71,8 +71,9 @@ public:
         checked(value, key, fieldKey);
         return {value[0].get<double>(), value[1].get<double>(), value[2].get<double>()};
     }
+    /// 8 numbers, each within the range of the field `fieldKey` (a Vec8, a DualQuat, or one axis of slice.axes).
     Vec8 vec8(const Json& value, const std::string& key, const std::string& fieldKey) const {
-        checked(value, key, fieldKey);
+        detail::checkVector(schema::field(fieldKey), value, key, source_ + ": ", 8);
         Vec8 v;
         for (std::size_t index = 0; index < 8; ++index) v[index] = value[index].get<double>();
         return v;
@@ -378,6 +379,8 @@ void readOutput(ObjectReader reader, OutputSettings& output) {
     reader.finish();
 }
 
+Params readDocument(const Json& document, const std::string& source, Validation validation);
+
 }  // namespace
 
 Params parseParams(const std::string& jsonText, const std::string& source, Validation validation) {
@@ -385,6 +388,16 @@ Params parseParams(const std::string& jsonText, const std::string& source, Valid
         throw ParamError("", source + ": the document has more than " + std::to_string(kMaxParamsBytes >> 20) +
                                  " MiB; a parameter file is a few kilobytes");
     const Json document = json::parseDocument(jsonText, source);
+    try {
+        return readDocument(document, source, validation);
+    } catch (const Json::exception& error) {  // a shape no check above foresaw: still the document's fault
+        throw ParamError("", source + ": malformed value: " + std::string(error.what()));
+    }
+}
+
+namespace {
+
+Params readDocument(const Json& document, const std::string& source, Validation validation) {
     Params params;
     ObjectReader root(document, "", source);
     if (const Json* value = root.find("version")) {
@@ -416,6 +429,8 @@ Params parseParams(const std::string& jsonText, const std::string& source, Valid
     }
     return params;
 }
+
+}  // namespace
 
 Params loadParams(const std::string& path, Validation validation) {
     auto fail = [&](const std::string& reason) {

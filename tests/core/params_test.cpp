@@ -80,6 +80,11 @@ TEST(Params, EachBadValueNamesItsKey) {
         {R"({"fractal": {"variant": "octonion"}})",
          "fractal.variant: must be one of paper, paper-coupled, dual, got \"octonion\""},
         {R"({"fractal": {"c": [1, 2]}})", "fractal.c: must be an array of 8 numbers"},
+        // one axis vector short (found by the fuzzer): named, not an internal error
+        {R"({"slice": {"axes": [[1,0,0,0,0,0,0,0],[0,1,0,0,0,0,0],[0,0,1,0,0,0,0,0]]}})",
+         "slice.axes[1]: must be an array of 8 numbers"},
+        {R"({"slice": {"axes": [[1,0,0,0,0,0,0,0],[0,1,0,0,0,0,0,0],[0,0,1,0,0,0,0,"z"]]}})",
+         "slice.axes[2][7]: must be a number"},
         {R"({"fractal": {"c": [0, 0, 0, 0, 0, 0, 0, "x"]}})", "fractal.c[7]: must be a number"},
         {R"({"fractal": {"c": [0, 0, 0, 0, 0, 0, 0, 1e999]}})",
          "test.json: malformed JSON: number overflow parsing '1e999'"},
