@@ -330,7 +330,7 @@ def missing_bakes(objects):
     return missing
 
 
-OSL_SOURCE = "dqjulia_osl_source"  # osl.SOURCE_KEY: an OSL volume's source object
+OSL_SOURCE = "dqjulia_osl_source"  # custom property of an OSL volume (osl.py): its source object
 
 
 def renders_nothing(scene_objects, source):

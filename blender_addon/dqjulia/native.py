@@ -524,20 +524,6 @@ class Context:
         )
         return vertices.value, triangles.value
 
-    def mesh_copy(self, colors=True):
-        """The context's mesh as ctypes arrays: (positions, normals, colors or None, triangles),
-        3 floats a vertex and 3 uint32 indices a triangle, in caller-owned buffers."""
-        vertex_count, triangle_count = self.mesh_sizes()
-        positions = (ctypes.c_float * (3 * vertex_count))()
-        normals = (ctypes.c_float * (3 * vertex_count))()
-        colours = (ctypes.c_float * (3 * vertex_count))() if colors else None
-        triangles = (ctypes.c_uint32 * (3 * triangle_count))()
-        function = _function("dqj_mesh_copy")
-        self.check(
-            function(self.handle, positions, normals, colours, vertex_count, triangles, triangle_count), "mesh copy"
-        )
-        return positions, normals, colours, triangles
-
     def mesh_faces(self, colors=True):
         """The context's mesh with its faces as the core made them: (positions, normals, colors or
         None, quads, triangles) as ctypes arrays; 4 and 3 uint32 indices a face."""

@@ -14,7 +14,7 @@ from . import bakes, preview
 
 SCRIPT_PATH = os.path.join(os.path.dirname(os.path.abspath(__file__)), "shaders", "dqjulia_density.osl")
 TEXT_NAME = "dqjulia_density.osl"
-SOURCE_KEY = "dqjulia_osl_source"  # bakes.OSL_SOURCE
+SOURCE_KEY = bakes.OSL_SOURCE  # custom property: the OSL volume's source object
 
 UNAVAILABLE_MESSAGE = (
     "This Blender was built without Open Shading Language (bpy.app.build_options.cycles_osl "

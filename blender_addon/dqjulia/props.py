@@ -166,18 +166,22 @@ def _quaternion_halves(key):
     return halves
 
 
+def _value_keys(prefix=""):
+    """The schema's value keys directly under `prefix`, in file order (not lists' items)."""
+    for key, field in FIELDS.items():
+        if (
+            key.startswith(prefix)
+            and "[]" not in key[len(prefix) :]
+            and (prefix or "[]" not in key)
+            and field["type"] not in ("object", "list", "color_list", "animation")
+        ):
+            yield key, field
+
+
 def _annotations(prefix):
     """The properties of every value key under `prefix` ("lights[]." for a light's)."""
     annotations = {}
-    for key, field in FIELDS.items():
-        if (
-            not key.startswith(prefix)
-            or "[]" in key[len(prefix) :]
-            or field["type"] in ("object", "list", "color_list", "animation")
-        ):
-            continue
-        if prefix == "" and "[]" in key:
-            continue
+    for key, field in _value_keys(prefix):
         kind = field["type"]
         if kind == "dual_quaternion":
             annotations.update(_quaternion_halves(key))
@@ -359,18 +363,6 @@ def _get(document, key):
             return None
         document = document[part]
     return document
-
-
-def _value_keys(prefix=""):
-    """The schema's value keys directly under `prefix`, in file order (not lists' items)."""
-    for key, field in FIELDS.items():
-        if (
-            key.startswith(prefix)
-            and "[]" not in key[len(prefix) :]
-            and (prefix or "[]" not in key)
-            and field["type"] not in ("object", "list", "color_list", "animation")
-        ):
-            yield key, field
 
 
 def _inside_auto(key):

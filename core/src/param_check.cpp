@@ -41,6 +41,13 @@ void checkNumber(const Field& field, const Json& value, const std::string& key, 
                  formatNumber(x));
 }
 
+std::string choiceList(const Field& field) {
+    std::string allowed;
+    for (const schema::Choice& choice : field.choices)
+        allowed += (allowed.empty() ? "" : ", ") + std::string(choice.name);
+    return allowed;
+}
+
 }  // namespace
 
 void checkVector(const Field& field, const Json& value, const std::string& key, const std::string& prefix,
@@ -49,6 +56,14 @@ void checkVector(const Field& field, const Json& value, const std::string& key, 
         fail(key, prefix, "must be an array of " + std::to_string(size) + " numbers, got " + describe(value));
     for (std::size_t index = 0; index < size; ++index)
         checkNumber(field, value[index], key + "[" + std::to_string(index) + "]", prefix);
+}
+
+void checkChoice(const Field& field, const Json& value, const std::string& key, const std::string& prefix) {
+    if (value.is_string())
+        for (const schema::Choice& choice : field.choices)
+            if (value.get<std::string>() == choice.name) return;
+    fail(key, prefix,
+         "must be one of " + choiceList(field) + ", got " + (value.is_string() ? value.dump() : describe(value)));
 }
 
 namespace {
@@ -62,20 +77,7 @@ void checkCount(const Field& field, const Json& value, const std::string& key, c
                  what + ", got " + describe(value));
 }
 
-std::string choiceList(const Field& field) {
-    std::string allowed;
-    for (const schema::Choice& choice : field.choices)
-        allowed += (allowed.empty() ? "" : ", ") + std::string(choice.name);
-    return allowed;
-}
 
-void checkChoice(const Field& field, const Json& value, const std::string& key, const std::string& prefix) {
-    if (value.is_string())
-        for (const schema::Choice& choice : field.choices)
-            if (value.get<std::string>() == choice.name) return;
-    fail(key, prefix,
-         "must be one of " + choiceList(field) + ", got " + (value.is_string() ? value.dump() : describe(value)));
-}
 
 void walk(const Json& node, const std::string& key) {
     const Field* field = key.empty() ? nullptr : schema::find(key);

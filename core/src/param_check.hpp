@@ -19,6 +19,10 @@ void checkValue(const schema::Field& field, const json::Json& value, const std::
 void checkVector(const schema::Field& field, const json::Json& value, const std::string& key, const std::string& prefix,
                  std::size_t size);
 
+/// Checks that `value` is the name of one of the field's choices.
+void checkChoice(const schema::Field& field, const json::Json& value, const std::string& key,
+                 const std::string& prefix);
+
 /// checkValue for every key of a whole document, as toJson writes it.
 void checkDocument(const json::Json& document);
 

@@ -78,14 +78,19 @@ public:
         for (std::size_t index = 0; index < 8; ++index) v[index] = value[index].get<double>();
         return v;
     }
-    /// A choice by name; `key` names a Choice field, or a ChoiceSet whose whole array was checked.
+    /// A choice by name, checked against the choices of the field `fieldKey` (a Choice, an item of
+    /// a ChoiceSet, or the animation's interpolations).
+    template <typename Enum>
+    Enum choice(const Json& value, const std::string& key, const std::string& fieldKey) const {
+        const schema::Field& field = schema::field(fieldKey);
+        detail::checkChoice(field, value, key, source_ + ": ");
+        std::size_t index = 0;
+        while (value.get<std::string>() != field.choices[index].name) ++index;  // checkChoice found it
+        return static_cast<Enum>(index);
+    }
     template <typename Enum>
     Enum choice(const Json& value, const std::string& key) const {
-        const schema::Field& field = schema::field(key);
-        if (field.type == schema::Type::Choice) checked(value, key);
-        for (std::size_t index = 0; index < field.choices.size(); ++index)
-            if (value.get<std::string>() == field.choices[index].name) return static_cast<Enum>(index);
-        fail(key, "unknown choice");  // not reached: checked() accepted it
+        return choice<Enum>(value, key, key);
     }
     template <typename Enum>
     void readChoice(const std::string& key, Enum& out) {
@@ -282,7 +287,8 @@ void readBake(ObjectReader reader, BakeSettings& bake) {
         const std::string key = reader.keyPath("grids");
         reader.checked(*value, key);
         bake.grids.clear();
-        for (const Json& name : *value) bake.grids.push_back(reader.choice<BakeGrid>(name, key));
+        for (std::size_t index = 0; index < value->size(); ++index)
+            bake.grids.push_back(reader.choice<BakeGrid>((*value)[index], indexed(key, index), key));
     }
     reader.read("adaptivity", bake.adaptivity);
     reader.read("mesh_colors", bake.meshColors);
@@ -351,17 +357,9 @@ void readAnimation(const Json& node, const std::string& source, std::vector<Trac
                 keyframe.value = value->get<std::vector<double>>();
             else
                 keyframe.value = {value->get<double>()};
-            if (const Json* interpolation = keyReader.find("interpolation")) {
-                const schema::Field& field = schema::field("animation");
-                const std::string at = keyReader.keyPath("interpolation");
-                bool found = false;
-                for (std::size_t choice = 0; choice < field.choices.size(); ++choice)
-                    if (interpolation->is_string() && interpolation->get<std::string>() == field.choices[choice].name) {
-                        keyframe.interpolation = static_cast<Interpolation>(choice);
-                        found = true;
-                    }
-                if (!found) keyReader.fail(at, "must be one of linear, smooth, got " + describe(*interpolation));
-            }
+            if (const Json* interpolation = keyReader.find("interpolation"))
+                keyframe.interpolation =
+                    keyReader.choice<Interpolation>(*interpolation, keyReader.keyPath("interpolation"), "animation");
             keyReader.finish();
             if (!track.keys.empty() && !(keyframe.frame > track.keys.back().frame))
                 keyReader.fail(keyReader.keyPath("frame"),
