@@ -3,7 +3,9 @@
 #   dqjulia/_buildinfo.py
 #   dqjulia/presets/    examples/*.json
 #   dqjulia/schema.json the parameter schema (dqjulia schema), which props.py builds the properties from
-#   dqjulia/lib/libdqjulia.so   the real library file (not a symlink), stripped
+#   dqjulia/lib/LIBRARY_NAME    the real library file (not a symlink), stripped: libdqjulia.so, or
+#                               dqjulia.dll in the Windows zip (PLATFORM windows-x64, the manifest's
+#                               platforms; EMULATOR runs the Windows dqjulia schema)
 cmake_minimum_required(VERSION 3.25)
 file(REMOVE_RECURSE "${STAGE}")
 file(MAKE_DIRECTORY "${STAGE}/dqjulia/lib" "${STAGE}/dqjulia/presets")
@@ -15,6 +17,7 @@ file(COPY "${BUILDINFO}" DESTINATION "${STAGE}/dqjulia")
 string(REPLACE "." ", " version_tuple "${VERSION}")
 file(READ "${STAGE}/dqjulia/blender_manifest.toml" text)
 string(REGEX REPLACE "\nversion = \"[0-9.]+\"" "\nversion = \"${VERSION}\"" text "${text}")
+string(REGEX REPLACE "\nplatforms = \\[[^]\n]*\\]" "\nplatforms = [\"${PLATFORM}\"]" text "${text}")
 file(WRITE "${STAGE}/dqjulia/blender_manifest.toml" "${text}")
 file(READ "${STAGE}/dqjulia/__init__.py" text)
 string(REGEX REPLACE "\"version\": \\([0-9, ]+\\)" "\"version\": (${version_tuple})" text "${text}")
@@ -23,15 +26,15 @@ file(GLOB examples "${EXAMPLES}/*.json")
 file(COPY ${examples} DESTINATION "${STAGE}/dqjulia/presets")
 # The schema the properties are built from, written by the core (tests/blender check it against
 # the library loaded and the properties registered).
-execute_process(COMMAND "${CLI}" schema OUTPUT_FILE "${STAGE}/dqjulia/schema.json" RESULT_VARIABLE result)
+execute_process(COMMAND ${EMULATOR} "${CLI}" schema OUTPUT_FILE "${STAGE}/dqjulia/schema.json" RESULT_VARIABLE result)
 if(NOT result EQUAL 0)
   message(FATAL_ERROR "could not write the parameter schema (dqjulia schema)")
 endif()
-file(COPY_FILE "${LIBRARY}" "${STAGE}/dqjulia/lib/libdqjulia.so")
-if(STRIP)  # the symbol table is for debuggers; the dynamic symbols (dqj_*) stay
-  execute_process(COMMAND "${STRIP}" --strip-unneeded "${STAGE}/dqjulia/lib/libdqjulia.so" RESULT_VARIABLE result)
+file(COPY_FILE "${LIBRARY}" "${STAGE}/dqjulia/lib/${LIBRARY_NAME}")
+if(STRIP)  # the symbol table is for debuggers; the dynamic symbols (dqj_*) and the DLL's exports stay
+  execute_process(COMMAND "${STRIP}" --strip-unneeded "${STAGE}/dqjulia/lib/${LIBRARY_NAME}" RESULT_VARIABLE result)
   if(NOT result EQUAL 0)
-    message(FATAL_ERROR "could not strip ${STAGE}/dqjulia/lib/libdqjulia.so")
+    message(FATAL_ERROR "could not strip ${STAGE}/dqjulia/lib/${LIBRARY_NAME}")
   endif()
 endif()
 get_filename_component(zip_dir "${ZIP}" DIRECTORY)

@@ -51,6 +51,13 @@ dqj_static_dependency(imath ARCHIVES libImath-3_1.a LINKS m INCLUDES "${dqj_deps
 dqj_static_dependency(openexr
   ARCHIVES libOpenEXR-3_1.a libOpenEXRUtil-3_1.a libOpenEXRCore-3_1.a libIlmThread-3_1.a libIex-3_1.a
   LINKS dqj::imath dqj::zlib Threads::Threads INCLUDES "${dqj_deps_include}/OpenEXR")
-dqj_static_dependency(tbb ARCHIVES libtbb.a LINKS Threads::Threads ${CMAKE_DL_LIBS} rt)
+if(WIN32)  # MinGW-w64 (cmake/toolchains/mingw-w64-x86_64.cmake): oneTBB's Windows name; OpenVDB's static-use defines
+  dqj_static_dependency(tbb ARCHIVES libtbb12.a LINKS Threads::Threads)
+  set(dqj_openvdb_defines OPENVDB_STATICLIB _USE_MATH_DEFINES)
+else()
+  dqj_static_dependency(tbb ARCHIVES libtbb.a LINKS Threads::Threads ${CMAKE_DL_LIBS} rt)
+  set(dqj_openvdb_defines)
+endif()
 dqj_static_dependency(hwy ARCHIVES libhwy.a DEFINES HWY_STATIC_DEFINE)
-dqj_static_dependency(openvdb ARCHIVES libopenvdb.a LINKS dqj::tbb dqj::imath dqj::zlib Threads::Threads)
+dqj_static_dependency(openvdb ARCHIVES libopenvdb.a LINKS dqj::tbb dqj::imath dqj::zlib Threads::Threads
+                      DEFINES ${dqj_openvdb_defines})

@@ -1,30 +1,57 @@
 #!/usr/bin/env bash
 # Builds the third-party libraries libdqjulia links statically, from Debian 12's own source
-# packages (the same versions Debian ships as shared libraries), as static, position-independent
-# archives in a cache outside the checkout:
+# packages (the same versions Debian ships as shared libraries), as static archives in a cache
+# outside the checkout:
 #
 #   zlib 1.2.13, libpng 1.6.39, Imath 3.1.6, OpenEXR 3.1.5, oneTBB 2021.8.0,
 #   Highway 1.0.3, OpenVDB 10.0.1 (no Blosc, no delayed loading: no Boost libraries)
 #
-# Usage: scripts/build-deps.sh            builds what is missing, then prints the prefix
-#        scripts/build-deps.sh --print    prints the prefix only (CMake reads it)
+# for Linux x86-64 (position-independent), or for Windows x64 with MinGW-w64
+# (cmake/toolchains/mingw-w64-x86_64.cmake), where the command's and the tests' other libraries
+# come from Debian's sources too, since the build machine's own are Linux ones: FreeType 2.12.1
+# (contact sheets), GoogleTest 1.12.1, and the header-only GLM 0.9.9.8, nlohmann/json 3.11.2 and
+# CLI11 2.1.2. Boost stays header-only: the Windows prefix links to the system's Boost headers
+# (libboost-dev) in include/boost, which OpenVDB's headers include.
 #
-# The prefix is $DQJ_DEPS_CACHE/linux-x64-<key>, where DQJ_DEPS_CACHE defaults to
+# Usage: scripts/build-deps.sh [--target linux-x64|windows-x64]           builds what is missing,
+#                                                                          then prints the prefix
+#        scripts/build-deps.sh [--target linux-x64|windows-x64] --print   prints the prefix only
+#
+# The prefix is $DQJ_DEPS_CACHE/<target>-<key>, where DQJ_DEPS_CACHE defaults to
 # ${XDG_CACHE_HOME:-$HOME/.cache}/dqjulia/deps and <key> names the versions and the recipe
 # revision, so a change of either builds anew beside the old one. A finished prefix is
 # complete (it is built in a temporary folder and renamed into place); a second run costs
-# nothing. About 8 minutes on 2 cores the first time. Needs: build-essential, cmake,
-# libboost-dev (headers only), and network access to Debian's archive (deb-src).
+# nothing. About 8 minutes on 2 cores the first time (Windows: about 6). Needs: build-essential,
+# cmake, libboost-dev (headers only), for Windows g++-mingw-w64-x86-64-posix, and network access
+# to Debian's archive (deb-src).
 set -euo pipefail
+
+target=linux-x64
+print=0
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --print) print=1 ;;
+    --target) target=${2:-}; shift ;;
+    --target=*) target=${1#--target=} ;;
+    *) echo "usage: scripts/build-deps.sh [--target linux-x64|windows-x64] [--print]" >&2; exit 2 ;;
+  esac
+  shift
+done
 
 here=$(cd "$(dirname "$0")" && pwd)
 versions="zlib-1.2.13_png-1.6.39_imath-3.1.6_exr-3.1.5_tbb-2021.8.0_hwy-1.0.3_vdb-10.0.1"
-recipe=1  # bump when the build options below change
+case "$target" in
+  linux-x64) recipe=1 ;;  # bump when the build options below change
+  windows-x64)
+    versions="${versions}_ft-2.12.1_gtest-1.12.1_glm-0.9.9.8_json-3.11.2_cli11-2.1.2"
+    recipe=5 ;;
+  *) echo "dqjulia deps: unknown target '$target' (linux-x64 or windows-x64)" >&2; exit 2 ;;
+esac
 key="${versions}_r${recipe}"
 cache="${DQJ_DEPS_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/dqjulia/deps}"
-prefix="$cache/linux-x64-$key"
+prefix="$cache/$target-$key"
 
-if [ "${1:-}" = "--print" ]; then
+if [ "$print" = 1 ]; then
   echo "$prefix"
   exit 0
 fi
@@ -36,13 +63,18 @@ fi
 # Debian's CMake 3.25: the pip one (4.x) refuses these projects' old cmake_minimum_required.
 cmake_bin=/usr/bin/cmake
 [ -x "$cmake_bin" ] || cmake_bin=cmake
+mingw=x86_64-w64-mingw32
+if [ "$target" = windows-x64 ] && ! command -v $mingw-g++-posix >/dev/null; then
+  echo "dqjulia deps: $mingw-g++-posix is missing: install g++-mingw-w64-x86-64-posix (scripts/install-deps.sh)" >&2
+  exit 1
+fi
 jobs=$(nproc)
 mkdir -p "$cache"
 work=$(mktemp -d "$cache/.build-XXXXXX")
 trap 'rm -rf "$work"' EXIT
 stage="$work/prefix"
 start=$(date +%s)
-log() { echo "dqjulia deps: $* ($(($(date +%s) - start)) s)" >&2; }
+log() { echo "dqjulia deps ($target): $* ($(($(date +%s) - start)) s)" >&2; }
 
 # --- sources: Debian's source packages, through a private apt state (the system's is untouched).
 apt_dir="$work/apt"
@@ -57,11 +89,17 @@ apt_opts=(-o Dir::Etc::sourcelist=/dev/null -o "Dir::Etc::sourceparts=$apt_dir/p
           -o "Dir::State::Lists=$apt_dir/lists" -o "Dir::Cache=$apt_dir/cache" -o APT::Sandbox::User=root)
 apt-get "${apt_opts[@]}" -q update >/dev/null
 # Only the upstream tarball (.orig) is needed; apt checks its hash against Debian's index.
-# Some Debian parts (.debian.tar.xz, a security update's .dsc) may be missing from the mirror.
-fetch() {  # fetch PACKAGE=VERSION ORIG_GLOB
-  (cd "$work/src" && apt-get "${apt_opts[@]}" -q source --download-only "$1" >/dev/null 2>&1) || true
-  local orig
-  orig=$(ls "$work/src"/$2 2>/dev/null | head -n 1)
+# Some Debian parts (.debian.tar.xz, a security update's .dsc) may be missing from the mirror,
+# and a security update's files may be missing altogether (zlib's): then the release's own
+# source (PACKAGE/bookworm), whose upstream tarball is the same.
+release=$(. /etc/os-release 2>/dev/null && echo "${VERSION_CODENAME:-}")
+fetch() {  # fetch PACKAGE ORIG_GLOB
+  local orig="" source
+  for source in "$1" ${release:+"$1/$release"}; do
+    (cd "$work/src" && apt-get "${apt_opts[@]}" -q source --download-only "$source" >/dev/null 2>&1) || true
+    orig=$(ls "$work/src"/$2 2>/dev/null | head -n 1 || true)
+    [ -z "$orig" ] || break
+  done
   if [ -z "$orig" ]; then
     echo "dqjulia deps: could not download the Debian source of $1 ($2)" >&2
     exit 1
@@ -76,11 +114,21 @@ fetch openexr 'openexr_3.1.5.orig.tar.*'
 fetch onetbb 'onetbb_2021.8.0.orig.tar.*'
 fetch highway 'highway_1.0.3.orig.tar.*'
 fetch openvdb 'openvdb_10.0.1.orig.tar.*'
+if [ "$target" = windows-x64 ]; then
+  fetch freetype 'freetype_2.12.1*.orig.tar.*'
+  fetch googletest 'googletest_1.12.1.orig.tar.*'
+  fetch glm 'glm_0.9.9.8*.orig.tar.*'
+  fetch nlohmann-json3 'nlohmann-json3_3.11.2.orig.tar.*'
+  fetch cli11 'cli11_2.1.2*.orig.tar.*'
+fi
 log "sources fetched"
 
 common=(-DCMAKE_BUILD_TYPE=Release -DCMAKE_POSITION_INDEPENDENT_CODE=ON -DBUILD_SHARED_LIBS=OFF
         "-DCMAKE_INSTALL_PREFIX=$stage" "-DCMAKE_PREFIX_PATH=$stage" -DCMAKE_INSTALL_LIBDIR=lib
         -DCMAKE_POLICY_VERSION_MINIMUM=3.5)
+if [ "$target" = windows-x64 ]; then
+  common+=("-DCMAKE_TOOLCHAIN_FILE=$here/../cmake/toolchains/mingw-w64-x86_64.cmake" "-DDQJ_DEPS_PREFIX=$stage")
+fi
 build() {  # build NAME [CMAKE OPTIONS...]
   local name=$1
   shift
@@ -91,24 +139,73 @@ build() {  # build NAME [CMAKE OPTIONS...]
   log "built $name"
 }
 
-# zlib: its own configure makes only the static archive.
-(cd "$work/src/zlib" && CFLAGS="-O2 -fPIC" ./configure --static --prefix="$stage" >"$work/zlib.log" 2>&1 \
+# zlib: its own configure makes only the static archive (CHOST: for MinGW).
+zlib_env=(CFLAGS="-O2 -fPIC")
+[ "$target" = windows-x64 ] && zlib_env=(CHOST=$mingw CC=$mingw-gcc-posix CFLAGS="-O2")
+(cd "$work/src/zlib" && env "${zlib_env[@]}" ./configure --static --prefix="$stage" >"$work/zlib.log" 2>&1 \
   && make -j"$jobs" libz.a >>"$work/zlib.log" 2>&1 && make install >>"$work/zlib.log" 2>&1) \
   || { tail -n 40 "$work/zlib.log" >&2; echo "dqjulia deps: building zlib failed" >&2; exit 1; }
 log "built zlib"
 zlib_opts=("-DZLIB_ROOT=$stage" "-DZLIB_LIBRARY=$stage/lib/libz.a" "-DZLIB_INCLUDE_DIR=$stage/include")
+
+openvdb_opts=()
+if [ "$target" = windows-x64 ]; then
+  # OpenVDB's headers include Boost's (header-only here): the system's, through a link in the
+  # prefix (adding /usr/include itself would mix Linux headers into the MinGW build). On WIN32
+  # its CMake links Boost::disable_autolinking, which only find_package(Boost) defines, and
+  # nothing finds Boost without delayed loading: an injected file defines it.
+  if [ ! -d /usr/include/boost ]; then
+    echo "dqjulia deps: the Boost headers are missing: install libboost-dev (scripts/install-deps.sh)" >&2
+    exit 1
+  fi
+  mkdir -p "$stage/include"
+  ln -s /usr/include/boost "$stage/include/boost"
+  cat > "$work/boost-headers.cmake" <<EOF
+if(NOT TARGET Boost::disable_autolinking)  # included after each of OpenVDB's project() calls
+  add_library(Boost::disable_autolinking INTERFACE IMPORTED)
+  set_target_properties(Boost::disable_autolinking PROPERTIES INTERFACE_COMPILE_DEFINITIONS BOOST_ALL_NO_LIB
+                        INTERFACE_INCLUDE_DIRECTORIES "$stage/include")
+endif()
+EOF
+  openvdb_opts=("-DCMAKE_PROJECT_INCLUDE=$work/boost-headers.cmake")
+fi
 
 build libpng1.6 "${zlib_opts[@]}" -DPNG_SHARED=OFF -DPNG_STATIC=ON -DPNG_TESTS=OFF -DPNG_EXECUTABLES=OFF
 build imath -DBUILD_TESTING=OFF -DPYTHON=OFF
 build openexr "${zlib_opts[@]}" -DBUILD_TESTING=OFF -DOPENEXR_BUILD_TOOLS=OFF -DOPENEXR_INSTALL_EXAMPLES=OFF \
   -DOPENEXR_INSTALL_TOOLS=OFF -DOPENEXR_INSTALL_PKG_CONFIG=OFF
 build onetbb -DTBB_TEST=OFF -DTBB_STRICT=OFF -DTBB_EXAMPLES=OFF -DTBBMALLOC_BUILD=OFF
+if [ "$target" = windows-x64 ]; then
+  # MinGW's oneTBB marks its functions dllexport (as linker directives in each object, its only
+  # ones): linked in statically they would be exported from dqjulia.dll and dqjulia.exe too.
+  $mingw-objcopy --remove-section=.drectve "$stage/lib/libtbb12.a"
+fi
 build highway -DHWY_ENABLE_TESTS=OFF -DHWY_ENABLE_EXAMPLES=OFF -DHWY_ENABLE_CONTRIB=OFF -DHWY_ENABLE_INSTALL=ON \
   -DHWY_FORCE_STATIC_LIBS=ON -DBUILD_TESTING=OFF
 build openvdb "${zlib_opts[@]}" "-DTBB_ROOT=$stage" -DOPENVDB_CORE_SHARED=OFF -DOPENVDB_CORE_STATIC=ON \
   -DOPENVDB_BUILD_BINARIES=OFF -DOPENVDB_BUILD_PYTHON_MODULE=OFF -DOPENVDB_BUILD_UNITTESTS=OFF \
   -DOPENVDB_BUILD_DOCS=OFF -DUSE_BLOSC=OFF -DUSE_ZLIB=ON -DUSE_EXPLICIT_INSTANTIATION=OFF \
-  -DOPENVDB_USE_DELAYED_LOADING=OFF -DUSE_PKGCONFIG=OFF
+  -DOPENVDB_USE_DELAYED_LOADING=OFF -DUSE_PKGCONFIG=OFF "${openvdb_opts[@]}"
+
+if [ "$target" = windows-x64 ]; then
+  # batch.cpp's vector exp and log: the header-only hwy/contrib/math (the contrib libraries unbuilt).
+  mkdir -p "$stage/include/hwy/contrib/math"
+  cp "$work/src/highway/hwy/contrib/math/"*.h "$stage/include/hwy/contrib/math/"
+  # FreeType with our zlib (without it, it compiles a copy of zlib in, whose symbols clash with it).
+  build freetype "${zlib_opts[@]}" -DFT_REQUIRE_ZLIB=ON -DFT_DISABLE_BZIP2=ON -DFT_DISABLE_PNG=ON \
+    -DFT_DISABLE_HARFBUZZ=ON -DFT_DISABLE_BROTLI=ON
+  build googletest -DBUILD_GMOCK=OFF -DINSTALL_GTEST=ON
+  build nlohmann-json3 -DJSON_BuildTests=OFF -DJSON_Install=ON
+  build cli11 -DCLI11_BUILD_TESTS=OFF -DCLI11_BUILD_EXAMPLES=OFF -DCLI11_BUILD_DOCS=OFF -DCLI11_INSTALL=ON
+  # GLM 0.9.9.8 has no install rule; its source tree's cmake/glm/glmConfig.cmake finds the headers
+  # beside it, and find_package looks in <prefix>/glm/cmake/glm/. It asks for CMake 3.2, which
+  # CMake 4 refuses: allowed up to 3.25's policies.
+  mkdir -p "$stage/glm"
+  cp -r "$work/src/glm/glm" "$work/src/glm/cmake" "$stage/glm/"
+  sed -i 's/^\(cmake_minimum_required(VERSION\|cmake_policy(VERSION\) 3\.2/\1 3.2...3.25/' \
+    "$stage/glm/cmake/glm/glmConfig.cmake"
+  log "installed glm"
+fi
 
 echo "$versions" > "$stage/.complete"
 rm -rf "$prefix"

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The README's second command: install what is missing, build, and run every test:
-# first the Release build, then the whole suite again built with clang under AddressSanitizer
-# and UndefinedBehaviorSanitizer, with the libFuzzer targets run for a bounded time.
+# first the Release build, then the Windows cross build's tests under Wine (against the Release
+# build), then the whole suite again built with clang under AddressSanitizer and
+# UndefinedBehaviorSanitizer, with the libFuzzer targets run for a bounded time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -9,6 +10,10 @@ scripts/bpy-env.sh
 scripts/ruff-env.sh
 scripts/build.sh
 ctest --test-dir build --output-on-failure -j"$(nproc)"
+
+echo "dqjulia: Windows cross build (MinGW-w64) and its tests under Wine"
+scripts/build-windows.sh
+ctest --test-dir build-windows --output-on-failure -j"$(nproc)"
 
 echo "dqjulia: sanitizer and fuzzing run (clang, ASan + UBSan)"
 source scripts/ccache.sh

@@ -6,6 +6,7 @@ struct's size and each field's offset and size as the C compiler lays them out
 (`c_api_test --layout`) against ctypes'.
 
 Usage: python3 native_abi_test.py SOURCE_DIR [C_API_TEST]
+       python3 native_abi_test.py SOURCE_DIR EMULATOR... C_API_TEST   (a Windows build's, under Wine)
 """
 
 import ctypes
@@ -81,7 +82,7 @@ def main():
 
     if len(sys.argv) > 2:
         # Lines "STRUCT SIZE" and "STRUCT.FIELD OFFSET SIZE".
-        layout = subprocess.run([sys.argv[2], "--layout"], check=True, capture_output=True, text=True).stdout
+        layout = subprocess.run(sys.argv[2:] + ["--layout"], check=True, capture_output=True, text=True).stdout
         sizes = {}
         for line in layout.splitlines():
             name, *numbers = line.split()

@@ -184,6 +184,7 @@ _lock = threading.Lock()
 _library = None
 _load_error = None
 _library_path = None
+_dll_directory = None  # Windows: the library's folder, added to the DLL search path while loaded
 _features = frozenset()  # the FEATURES the loaded library has
 _bound = frozenset()  # the functions of _SIGNATURES it offers
 
@@ -192,8 +193,15 @@ def version_text(number):
     return "%d.%d.%d" % (number // 10000, number // 100 % 100, number % 100)
 
 
+# What the library needs of the system it runs on, by sys.platform (for the message when it does not load).
+_REQUIREMENTS = {
+    "win32": "64-bit Windows (x64) with its own system libraries",
+    "linux": "Linux x86-64 with glibc 2.34 or newer (Debian 12, Ubuntu 22.04, RHEL 9 or later)",
+}
+
+
 def bundled_library_path():
-    """Where the zip puts the library: lib/ beside this file."""
+    """Where the zip puts the library: lib/ beside this file (the zip made for this platform)."""
     names = {"win32": "dqjulia.dll", "darwin": "libdqjulia.dylib"}
     return os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib", names.get(sys.platform, "libdqjulia.so"))
 
@@ -229,7 +237,7 @@ def _bind(library):
 
 
 def _load():
-    global _library_path
+    global _library_path, _dll_directory
     path = library_path()
     _library_path = path
     if not os.path.isfile(path):
@@ -238,12 +246,14 @@ def _load():
             "makes (build/dist/dqjulia_blender.zip), which holds the library; reinstall it" % path
         )
     try:
+        if hasattr(os, "add_dll_directory") and _dll_directory is None:  # Windows: DLLs beside it are found
+            _dll_directory = os.add_dll_directory(os.path.dirname(os.path.abspath(path)))
         library = ctypes.CDLL(path)
     except OSError as error:
         raise NativeUnavailable(
             "the dqjulia native library at %s could not be loaded (%s). It is self-contained and needs only "
-            "Linux x86-64 with glibc 2.34 or newer (Debian 12, Ubuntu 22.04, RHEL 9 or later); on another "
-            "system, build the add-on there (README, Two commands)" % (path, error)
+            "%s; on another system, build the add-on there (README, Two commands)"
+            % (path, error, _REQUIREMENTS.get(sys.platform, _REQUIREMENTS["linux"]))
         ) from error
     try:
         version_number = library.dqj_version_number

@@ -1,6 +1,12 @@
 #include "bake_options.hpp"
 
+#ifdef _WIN32
+#include <windows.h>
+#define PSAPI_VERSION 2  // GetProcessMemoryInfo from kernel32.dll, not psapi.dll
+#include <psapi.h>
+#else
 #include <sys/resource.h>
+#endif
 
 #include <cmath>
 #include <cstdio>
@@ -192,9 +198,23 @@ std::string evaluatedSummary(const BakeStats& stats) {
            percent(stats.evaluated, stats.dense) + ")";
 }
 
-void printBakeStats(const BakeStats& stats) {
+namespace {
+
+/// The process's peak resident memory.
+std::uint64_t peakMemoryBytes() {
+#ifdef _WIN32
+    PROCESS_MEMORY_COUNTERS counters{};
+    return ::GetProcessMemoryInfo(::GetCurrentProcess(), &counters, sizeof counters) ? counters.PeakWorkingSetSize : 0;
+#else
     rusage usage{};
     ::getrusage(RUSAGE_SELF, &usage);
+    return std::uint64_t(usage.ru_maxrss) * 1024;
+#endif
+}
+
+}  // namespace
+
+void printBakeStats(const BakeStats& stats) {
     std::cout << "seconds " << stats.seconds << "\n"
               << "voxel_size " << stats.voxelSize << "\n"
               << "voxels_evaluated " << stats.evaluated << "\n"
@@ -205,7 +225,7 @@ void printBakeStats(const BakeStats& stats) {
               << "pruned_leaves " << stats.prunedLeaves << "\n"
               << "active_voxels " << stats.activeVoxels << "\n"
               << "estimated_bytes " << stats.estimatedBytes << "\n"
-              << "peak_memory_bytes " << std::uint64_t(usage.ru_maxrss) * 1024 << "\n";
+              << "peak_memory_bytes " << peakMemoryBytes() << "\n";
 }
 
 }  // namespace dqj::cli

@@ -1,6 +1,10 @@
 #include "common.hpp"
 
+#ifdef _WIN32
+#include <windows.h>
+#else
 #include <unistd.h>
+#endif
 
 #include <atomic>
 #include <chrono>
@@ -10,13 +14,32 @@
 #include <iostream>
 
 #include "dqjulia/estimate.hpp"
+#include "file_names.hpp"
 
 namespace dqj::cli {
 namespace {
 
 std::atomic<bool> interruptRequested{false};
 
+#ifdef _WIN32
+/// Ctrl-C, Ctrl-Break and a closed console window (Windows stops the process shortly after that one).
+BOOL WINAPI onConsoleEvent(DWORD event) {
+    if (event != CTRL_C_EVENT && event != CTRL_BREAK_EVENT && event != CTRL_CLOSE_EVENT) return FALSE;
+    interruptRequested.store(true);
+    return TRUE;
+}
+
+/// Whether stderr is a console that draws the bar's escape codes (Windows 10 and later, once asked).
+bool stderrIsTerminal() {
+    const HANDLE console = ::GetStdHandle(STD_ERROR_HANDLE);
+    DWORD mode = 0;
+    return ::GetConsoleMode(console, &mode) && ::SetConsoleMode(console, mode | ENABLE_VIRTUAL_TERMINAL_PROCESSING);
+}
+#else
 extern "C" void onInterrupt(int) { interruptRequested.store(true); }
+
+bool stderrIsTerminal() { return isatty(STDERR_FILENO); }
+#endif
 
 double nowSeconds() {
     using namespace std::chrono;
@@ -38,19 +61,40 @@ std::string formatDuration(double seconds) {
 }  // namespace
 
 void installInterruptHandlers() {
+#ifdef _WIN32
+    ::SetConsoleCtrlHandler(onConsoleEvent, TRUE);
+#else
     struct sigaction action {};
     action.sa_handler = onInterrupt;
     sigemptyset(&action.sa_mask);
     sigaction(SIGINT, &action, nullptr);
     sigaction(SIGTERM, &action, nullptr);
     sigaction(SIGHUP, &action, nullptr);  // a closed terminal or a dropped SSH session: stop cleanly as for SIGTERM
+#endif
 }
 
 bool interrupted() { return interruptRequested.load(); }
 
+CLI::Validator existingFile() {
+    return CLI::Validator(
+        [](std::string& name) -> std::string {
+            std::error_code error;
+            std::filesystem::file_status status;
+            try {
+                status = std::filesystem::status(pathFromUtf8(name), error);
+            } catch (const std::filesystem::filesystem_error&) {
+                return "File name is not valid UTF-8: " + name;
+            }
+            if (!std::filesystem::exists(status)) return "File does not exist: " + name;
+            if (std::filesystem::is_directory(status)) return "File is actually a directory: " + name;
+            return "";
+        },
+        "FILE", "EXISTING_FILE");
+}
+
 void FractalOptions::addTo(CLI::App& command) {
     command.add_option("-p,--params", paramsFile, "Parameter file (JSON, see README); flags override its values")
-        ->check(CLI::ExistingFile);
+        ->check(existingFile());
     command.add_option("--c", constant, "Constant: 8 numbers, a's s i j k then b's s i j k")->expected(8);
     command.add_option("--variant", variant, "Algebra: paper, paper-coupled or dual")
         ->check(CLI::IsMember({"paper", "paper-coupled", "dual"}));
@@ -115,8 +159,8 @@ Params FractalOptions::load() const {
 void checkOutputPath(const std::string& path, bool force, const std::string& flag) {
     namespace fs = std::filesystem;
     std::error_code error;
-    const fs::path target(path);
     if (path.empty()) throw ParamError("output.path", flag + " is empty; give a file name");
+    const fs::path target = pathFromUtf8(path);
     if (fs::is_directory(target, error))
         throw ParamError("output.path", flag + " '" + path + "' is a folder; give a file name");
     if (fs::exists(target, error) && !fs::is_regular_file(target, error))
@@ -127,9 +171,12 @@ void checkOutputPath(const std::string& path, bool force, const std::string& fla
         throw ParamError("output.path", flag + " '" + path + "' exists; pass --force to overwrite it");
     const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
     if (!fs::is_directory(folder, error))
-        throw ParamError("output.path", flag + " '" + path + "': the folder '" + folder.string() + "' does not exist");
+        throw ParamError("output.path",
+                         flag + " '" + path + "': the folder '" + utf8FromPath(folder) + "' does not exist");
+#ifndef _WIN32  // Windows: access() does not read a folder's permissions (ACLs); the probe below tries
     if (::access(folder.c_str(), W_OK) != 0)
         throw ParamError("output.path", flag + " '" + path + "': the folder '" + folder.string() + "' is not writable");
+#endif
     try {
         checkWritable(path);  // not a device or FIFO, and a file can really be created there
     } catch (const std::runtime_error& failure) {
@@ -142,8 +189,8 @@ void checkDistinctOutputs(const std::vector<std::pair<std::string, std::string>>
     std::vector<fs::path> resolved;
     for (const auto& [flag, path] : outputs) {
         std::error_code error;
-        fs::path canonical = fs::weakly_canonical(fs::absolute(path, error), error);
-        resolved.push_back(error ? fs::path(path).lexically_normal() : canonical);
+        fs::path canonical = fs::weakly_canonical(fs::absolute(pathFromUtf8(path), error), error);
+        resolved.push_back(error ? pathFromUtf8(path).lexically_normal() : canonical);
     }
     for (std::size_t a = 0; a < outputs.size(); ++a)
         for (std::size_t b = 0; b < a; ++b)
@@ -179,7 +226,7 @@ int reportErrors(const std::string& command, const std::function<int()>& body) {
 }
 
 ProgressBar::ProgressBar(std::string label, bool quiet)
-    : label_(std::move(label)), enabled_(!quiet && isatty(STDERR_FILENO)), startSeconds_(nowSeconds()) {}
+    : label_(std::move(label)), enabled_(!quiet && stderrIsTerminal()), startSeconds_(nowSeconds()) {}
 
 ProgressBar::~ProgressBar() {
     if (drawn_) std::cerr << "\n";

@@ -71,8 +71,13 @@ private:
     bool drawn_ = false;
 };
 
-/// Installs SIGINT/SIGTERM/SIGHUP handlers that ask running work to stop (see interrupted()).
+/// Installs SIGINT/SIGTERM/SIGHUP handlers that ask running work to stop (see interrupted()); on
+/// Windows, a console handler for Ctrl-C, Ctrl-Break and a closed console.
 void installInterruptHandlers();
 bool interrupted();
+
+/// CLI11's ExistingFile for the command's UTF-8 file names (CLI11's own reads them in the ANSI
+/// code page on Windows), with its messages.
+CLI::Validator existingFile();
 
 }  // namespace dqj::cli

@@ -7,6 +7,7 @@
 #include "contact_sheet.hpp"
 #include "explore.hpp"
 #include "dqjulia/render.hpp"
+#include "file_names.hpp"
 
 namespace dqj::cli {
 namespace {
@@ -32,12 +33,12 @@ int runExplore(const ExploreCommandOptions& options) {
     validate(base);
 
     namespace fs = std::filesystem;
-    const fs::path folder(options.folder);
+    const fs::path folder = pathFromUtf8(options.folder);
     const fs::path sheetPath = folder / "sheet.png";
     std::error_code error;
     fs::create_directories(folder, error);
-    if (error) throw std::runtime_error("cannot create folder '" + folder.string() + "': " + error.message());
-    checkOutputPath(sheetPath.string(), options.force, "--output");
+    if (error) throw std::runtime_error("cannot create folder '" + options.folder + "': " + error.message());
+    checkOutputPath(utf8FromPath(sheetPath), options.force, "--output");
 
     ExploreOptions exploreOptions;
     exploreOptions.seed = options.seed;
@@ -53,22 +54,22 @@ int runExplore(const ExploreCommandOptions& options) {
         Params tile = found.tiles[index];
         char name[32];
         std::snprintf(name, sizeof name, "tile_%02zu", index + 1);
-        tile.output.path = (folder / (std::string(name) + ".png")).string();
+        tile.output.path = utf8FromPath(folder / (std::string(name) + ".png"));
         // Each tile's share of the progress bar; Ctrl-C stops between and inside tiles.
         const double start = double(index) / found.tiles.size(), share = 1.0 / found.tiles.size();
         const ProgressCallback callback = progress.callback();
         const RenderResult result = render(tile, [&](double fraction) { return callback(start + share * fraction); });
         writeImage(result.image, tile.output.path, ImageFormat::Png8);
-        saveParams(tile, (folder / (std::string(name) + ".json")).string());
+        saveParams(tile, utf8FromPath(folder / (std::string(name) + ".json")));
         tiles.push_back({result.image, std::string(name) + "  " + constantText(tile.fractal.c, 3)});
     }
     progress.finish();
     SheetLayout layout;
     layout.columns = options.columns;
-    writeImage(composeSheet(tiles, layout), sheetPath.string(), ImageFormat::Png8, existingPolicy(options.force));
+    writeImage(composeSheet(tiles, layout), utf8FromPath(sheetPath), ImageFormat::Png8, existingPolicy(options.force));
     if (!options.quiet)
-        std::cerr << "wrote " << sheetPath.string() << " and " << tiles.size()
-                  << " tiles (tile_NN.png, tile_NN.json) to " << folder.string() << "; " << found.skippedEmpty << " of "
+        std::cerr << "wrote " << utf8FromPath(sheetPath) << " and " << tiles.size()
+                  << " tiles (tile_NN.png, tile_NN.json) to " << options.folder << "; " << found.skippedEmpty << " of "
                   << found.attempts << " candidate constants skipped for empty slices\n";
     return kSuccess;
 }

@@ -1,12 +1,20 @@
 // dqjulia: render, evaluate and inspect dual-quaternion Julia fractals from the command line.
 #include <iostream>
 #include <map>
+#include <string>
+#include <vector>
+
+#ifdef _WIN32
+#include <windows.h>
+#endif
 
 #include "commands.hpp"
 #include "common.hpp"
 #include "dqjulia/dqjulia.h"
 
-int main(int argc, char** argv) {
+namespace {
+
+int run(int argc, char** argv) {
     using namespace dqj::cli;
     CLI::App app{
         "dqjulia: dual-quaternion Julia fractals (zeta <- zeta^2 + c in 8-D, sliced to 3-D).\n"
@@ -38,3 +46,28 @@ int main(int argc, char** argv) {
         if (command->parsed()) return runner();
     return kBadInput;
 }
+
+}  // namespace
+
+#ifdef _WIN32
+// Windows hands narrow arguments in the ANSI code page, which cannot hold every file name: the
+// command takes its UTF-16 arguments (wmain, linked with -municode) as UTF-8, the toolkit's file
+// names, and writes UTF-8 to the console.
+int wmain(int argc, wchar_t** wideArgv) {
+    std::vector<std::string> arguments;
+    for (int index = 0; index < argc; ++index) {
+        const int bytes = ::WideCharToMultiByte(CP_UTF8, 0, wideArgv[index], -1, nullptr, 0, nullptr, nullptr);
+        std::string argument(bytes > 0 ? std::size_t(bytes) : 1, '\0');
+        ::WideCharToMultiByte(CP_UTF8, 0, wideArgv[index], -1, argument.data(), bytes, nullptr, nullptr);
+        argument.resize(argument.size() - 1);  // the terminating NUL
+        arguments.push_back(std::move(argument));
+    }
+    std::vector<char*> argv;
+    for (std::string& argument : arguments) argv.push_back(argument.data());
+    argv.push_back(nullptr);
+    ::SetConsoleOutputCP(CP_UTF8);
+    return run(argc, argv.data());
+}
+#else
+int main(int argc, char** argv) { return run(argc, argv); }
+#endif

@@ -8,6 +8,7 @@
 #include "common.hpp"
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/povray.hpp"
+#include "file_names.hpp"
 
 namespace dqj::cli {
 namespace {
@@ -65,7 +66,7 @@ int runPovray(const PovrayOptions& options) {
     if (!files.df3.empty()) checkOutputPath(files.df3, options.force, "--df3");
     if (!files.df3Scene.empty()) checkOutputPath(files.df3Scene, options.force, "--df3");
     if (!files.include.empty()) {
-        std::ifstream existing(files.include, std::ios::binary);
+        std::ifstream existing(pathFromUtf8(files.include), std::ios::binary);
         std::ostringstream text;
         text << existing.rdbuf();
         if (existing && text.str() != povrayInclude() && !options.force)
@@ -85,9 +86,10 @@ int runPovray(const PovrayOptions& options) {
         for (const std::string& path : written) std::cerr << "wrote " << path << "\n";
         // POV-Ray looks for the include and the DF3 file in the folder it runs in and on its
         // library path, not beside the scene: run it in the scene's folder.
-        const std::filesystem::path scene(files.scene.empty() ? files.df3Scene : files.scene);
-        std::cerr << "render with: " << (scene.has_parent_path() ? "cd '" + scene.parent_path().string() + "' && " : "")
-                  << povrayCommand(params, scene.filename().string())
+        const std::filesystem::path scene = pathFromUtf8(files.scene.empty() ? files.df3Scene : files.scene);
+        std::cerr << "render with: "
+                  << (scene.has_parent_path() ? "cd '" + utf8FromPath(scene.parent_path()) + "' && " : "")
+                  << povrayCommand(params, utf8FromPath(scene.filename()))
                   << (write.copyInclude ? "" : " +L<dqjulia>/povray") << "\n";
     }
     return kSuccess;

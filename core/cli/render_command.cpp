@@ -136,7 +136,7 @@ Runner addRenderCommand(CLI::App& app) {
     command
         ->add_option("--voxels", options->voxels,
                      "Draw the voxels of a baked VDB (its density grid) as cubes instead of tracing the fractal")
-        ->check(CLI::ExistingFile);
+        ->check(existingFile());
     command->add_flag("-f,--force", options->force, "Overwrite existing output files");
     command->add_flag("-q,--quiet", options->quiet, "No progress bar or summary");
     command->add_flag("--stats", options->stats, "Print ray and step counts to stdout");

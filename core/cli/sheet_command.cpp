@@ -40,7 +40,7 @@ Runner addSheetCommand(CLI::App& app) {
     CLI::App* command = app.add_subcommand("sheet", "Lay PNG images out in a contact sheet with a label under each");
     command->add_option("-t,--tile", options->images, "A PNG image (repeat, in order)")
         ->required()
-        ->check(CLI::ExistingFile);
+        ->check(existingFile());
     command->add_option("-l,--label", options->labels, "Its label (repeat, one per --tile; \\n breaks lines)");
     command->add_option("-o,--output", options->output, "The sheet (.png)")->required();
     command->add_option("--columns", options->columns, "Tiles per row")->check(CLI::Range(1, 20));

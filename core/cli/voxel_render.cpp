@@ -8,15 +8,15 @@
 #include <cerrno>
 #include <cstring>
 #include <fstream>
+#include <filesystem>
 #include <limits>
-
-#include <sys/stat.h>
 
 #include <glm/geometric.hpp>
 #include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
 
 #include "dqjulia/coloring.hpp"
+#include "file_names.hpp"
 #include "parallel_progress.hpp"
 
 namespace dqj {
@@ -97,11 +97,13 @@ std::string shortMessage(const std::string& text) {
 openvdb::FloatGrid::ConstPtr readDensity(const std::string& path) {
     openvdb::initialize();
     auto fail = [&](const std::string& reason) { return std::runtime_error("cannot read '" + path + "': " + reason); };
-    std::ifstream in(path, std::ios::binary);
+    const std::filesystem::path name = pathFromUtf8(path);
+    std::ifstream in(name, std::ios::binary);
     if (!in) throw fail(std::strerror(errno));
-    struct stat info {};
-    if (::stat(path.c_str(), &info) != 0 || !S_ISREG(info.st_mode)) throw fail("not a regular file");
-    const std::string problem = checkVdbContainer(in, std::uint64_t(info.st_size));
+    std::error_code error;
+    const std::uintmax_t size = std::filesystem::file_size(name, error);  // fails for all but regular files
+    if (error || !std::filesystem::is_regular_file(name, error)) throw fail("not a regular file");
+    const std::string problem = checkVdbContainer(in, std::uint64_t(size));
     if (!problem.empty()) throw fail(problem);
     in.clear();
     in.seekg(0);

@@ -9,6 +9,8 @@
 // so a full disk or a failing device is an error ("No space left on device"), never a
 // truncated file. commit() either replaces an existing file (Existing::Replace) or refuses to
 // (Existing::Keep, atomically: a file created meanwhile by someone else is never replaced).
+// Names are UTF-8 (file_names.hpp). Windows has no unnamed files: there the hidden name is always
+// used, held open so that no other writer removes it, and published with MoveFileExW.
 #pragma once
 
 #include <memory>
@@ -50,7 +52,8 @@ public:
 
     /// "cannot write 'path': reason" - the message writers use for their own failures too.
     static std::string failureMessage(const std::string& path, const std::string& reason);
-    /// The extension of a path's file name in lower case, with its dot (".vdb"), or "".
+    /// The extension of a path's file name in lower case, with its dot (".vdb"), or "". Throws
+    /// std::runtime_error for a name that is not UTF-8 where names must be (Windows).
     static std::string lowercaseExtension(const std::string& path);
 
     struct State;

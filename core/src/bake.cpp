@@ -15,8 +15,12 @@
 #include <string>
 #include <vector>
 
+#ifdef _WIN32
+#include <windows.h>
+#else
 #include <sys/resource.h>
 #include <unistd.h>
+#endif
 
 #include <openvdb/io/File.h>
 #include <openvdb/tools/LevelSetRebuild.h>
@@ -188,6 +192,33 @@ openvdb::FloatGrid::Ptr bakeLevelSet(const Params& params, const BakeOptions& op
 MemoryLimitError::MemoryLimitError(const std::string& message, std::uint64_t estimate, std::uint64_t limit)
     : ParamError("bake.resolution", "bake.resolution: " + message), estimate_(estimate), limit_(limit) {}
 
+#ifdef _WIN32
+
+// Windows: the limits a job object puts on this process and on its job (what ulimit and cgroups are
+// on Linux; the job's less its peak use), and half of the physical memory available.
+std::uint64_t processMemoryHeadroom() {
+    JOBOBJECT_EXTENDED_LIMIT_INFORMATION job{};
+    if (!::QueryInformationJobObject(nullptr, JobObjectExtendedLimitInformation, &job, sizeof job, nullptr))
+        return UINT64_MAX;  // not in a job
+    std::uint64_t result = UINT64_MAX;
+    const DWORD flags = job.BasicLimitInformation.LimitFlags;
+    if (flags & JOB_OBJECT_LIMIT_PROCESS_MEMORY) result = std::min<std::uint64_t>(result, job.ProcessMemoryLimit);
+    if (flags & JOB_OBJECT_LIMIT_JOB_MEMORY)
+        result = std::min<std::uint64_t>(result, job.JobMemoryLimit > job.PeakJobMemoryUsed
+                                                     ? job.JobMemoryLimit - job.PeakJobMemoryUsed
+                                                     : 0);
+    return result;
+}
+
+std::uint64_t defaultMemoryLimit() {
+    MEMORYSTATUSEX status{};
+    status.dwLength = sizeof status;
+    const std::uint64_t half = ::GlobalMemoryStatusEx(&status) ? status.ullAvailPhys / 2 : std::uint64_t(1) << 31;
+    return std::min(half, processMemoryHeadroom());
+}
+
+#else
+
 namespace {
 
 /// A number from a one-line file ("max" and unreadable files: nullopt).
@@ -261,6 +292,8 @@ std::uint64_t defaultMemoryLimit() {
     }
     return std::min(half, processMemoryHeadroom());
 }
+
+#endif
 
 std::string formatBytes(std::uint64_t bytes) {
     char text[32];

@@ -24,6 +24,7 @@
 #include <half.h>
 
 #include "atomic_file.hpp"
+#include "file_names.hpp"
 
 namespace dqj {
 namespace {
@@ -285,7 +286,7 @@ Image readPng(const std::string& path) {
     auto fail = [&](const std::string& reason) { return std::runtime_error("cannot read '" + path + "': " + reason); };
     PngRead read;
     PngReadGuard guard{read};
-    read.file = std::fopen(path.c_str(), "rb");
+    read.file = openFile(path, "rb");
     if (!read.file) throw fail(std::strerror(errno));
     png_byte signature[8] = {};
     if (std::fread(signature, 1, 8, read.file) != 8 || png_sig_cmp(signature, 0, 8) != 0) throw fail("not a PNG file");

@@ -8,12 +8,12 @@
 #include <cmath>
 #include <cstring>
 
-#include <fcntl.h>
 #include <unistd.h>
 
 #include "atomic_file.hpp"
 #include "dqjulia/param_file.hpp"
 #include "dqjulia/schema.hpp"
+#include "file_names.hpp"
 #include "json_text.hpp"
 #include "param_check.hpp"
 
@@ -434,7 +434,7 @@ Params loadParams(const std::string& path, Validation validation) {
     auto fail = [&](const std::string& reason) {
         return ParamError("", "cannot read parameter file '" + path + "': " + reason);
     };
-    const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+    const int fd = openForReading(path);
     if (fd < 0) throw fail(std::strerror(errno));
     // Read at most one byte beyond the limit, so a never-ending file (/dev/zero, a stalled
     // pipe's writer) cannot grow the buffer without bound. A signal (Ctrl-C) ends the read.

@@ -18,6 +18,7 @@
 #include "dqjulia/coloring.hpp"
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/render.hpp"
+#include "file_names.hpp"
 #include "parallel_progress.hpp"
 
 namespace dqj {
@@ -435,11 +436,11 @@ void writeDf3(const DensityGrid& grid, const std::string& path, int bits, Existi
 
 PovrayFiles povrayFiles(const Params& params, const std::string& scenePath, const PovrayWriteOptions& options) {
     namespace fs = std::filesystem;
-    const fs::path scene(scenePath);
+    const fs::path scene = pathFromUtf8(scenePath);
     if (scenePath.empty() || !scene.has_filename())
         throw std::runtime_error(AtomicFile::failureMessage(scenePath, "not a file name"));
     const fs::path folder = scene.parent_path();
-    const std::string stem = (folder / scene.stem()).string();
+    const std::string stem = utf8FromPath(folder / scene.stem());
     if (params.fractal.iterations > kPovrayMaxIterations && !options.df3)
         throw iterationLimitError(params.fractal.iterations);
     PovrayFiles files;
@@ -449,20 +450,20 @@ PovrayFiles povrayFiles(const Params& params, const std::string& scenePath, cons
         files.df3Scene = stem + "_df3.pov";
         // The DF3 scene names the grid file in a POV-Ray string, which carries printable
         // ASCII only (POV-Ray 3.7 reads strings as ASCII; quotes and backslashes are escapes).
-        for (const char ch : fs::path(files.df3).filename().string())
+        const std::string df3Name = utf8FromPath(pathFromUtf8(files.df3).filename());
+        for (const char ch : df3Name)
             if (ch < 0x20 || ch > 0x7e || ch == '"' || ch == '\\')
                 throw ParamError("output.path", "'" + scenePath + "': with --df3 the scene names the grid file '" +
-                                                    fs::path(files.df3).filename().string() +
+                                                    df3Name +
                                                     "' in a POV-Ray string, which carries only printable ASCII "
                                                     "characters without \" and \\; rename the scene");
     }
-    if (options.copyInclude) files.include = (folder / "dqjulia.inc").string();
+    if (options.copyInclude) files.include = utf8FromPath(folder / "dqjulia.inc");
     return files;
 }
 
 std::vector<std::string> writePovray(const Params& params, const std::string& scenePath,
                                      const PovrayWriteOptions& options, const ProgressCallback& progress) {
-    namespace fs = std::filesystem;
     if (options.df3 && options.df3Bits != 8 && options.df3Bits != 16 && options.df3Bits != 32)
         throw ParamError("df3.bits", "DF3 samples are 8, 16 or 32 bits, got " + std::to_string(options.df3Bits));
     const PovrayFiles files = povrayFiles(params, scenePath, options);
@@ -478,7 +479,7 @@ std::vector<std::string> writePovray(const Params& params, const std::string& sc
     if (options.df3) {
         grid = bakeDensityGrid(params, options.df3Resolution, progress);
         PovraySceneOptions df3Options = sceneOptions;
-        df3Options.df3Name = fs::path(files.df3).filename().string();
+        df3Options.df3Name = utf8FromPath(pathFromUtf8(files.df3).filename());
         df3Options.grid = &grid;
         df3SceneText = povrayScene(params, df3Options);
     }
@@ -497,7 +498,7 @@ std::vector<std::string> writePovray(const Params& params, const std::string& sc
         writeFile(files.df3Scene, df3SceneText);
     }
     if (!files.include.empty()) {
-        std::ifstream existing(files.include, std::ios::binary);
+        std::ifstream existing(pathFromUtf8(files.include), std::ios::binary);
         std::ostringstream current;
         current << existing.rdbuf();
         if (!existing || current.str() != povrayInclude()) writeFile(files.include, std::string(povrayInclude()));

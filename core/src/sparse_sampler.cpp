@@ -457,7 +457,13 @@ double bakeVoxelSize(const Params& params) {
     return std::max(size.x, std::max(size.y, size.z)) / params.bake.resolution;
 }
 
-void releaseFreedMemory() { malloc_trim(0); }
+void releaseFreedMemory() {
+#ifdef _WIN32
+    _heapmin();  // the C runtime's heap, to the system
+#else
+    malloc_trim(0);
+#endif
+}
 
 SampledSurface sampleSurface(const Params& params, const BakeOptions& options, const MemoryModel& memory,
                              StagedProgress& progress, double split, double end) {

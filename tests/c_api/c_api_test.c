@@ -1,15 +1,24 @@
 /* The C ABI used from a program written in C (not C++): versions, features, parameters,
  * evaluation against reference values, errors per handle, rendering with progress and cancel,
- * a growing result struct.
+ * a growing result struct, and UTF-8 file names (on Windows too, where the test of the Windows
+ * build runs it under Wine with SCRATCH_DIR as a drive letter and backslashes).
  *
  *   c_api_test [SCRATCH_DIR]   the checks
  *   c_api_test --layout        prints the size of each struct and the offset and size of each
  *                              field, for tests/native_abi_test.py to hold the ctypes bindings to */
+#include <errno.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#ifdef _WIN32
+#include <direct.h>
+#include <windows.h>
+#else
+#include <sys/stat.h>
+#endif
 
 #include "dqjulia/dqjulia.h"
 
@@ -242,6 +251,83 @@ static void test_empty_slice(dqj_context context) {
           dqj_context_warning(context));
 }
 
+#ifdef _WIN32
+#define SEPARATOR '\\'
+/* Windows opens a UTF-8 name by its UTF-16 form. */
+static wchar_t* widen(const char* text) {
+    static wchar_t buffers[2][1024];
+    static int next = 0;
+    wchar_t* wide = buffers[next++ % 2];
+    if (!MultiByteToWideChar(CP_UTF8, MB_ERR_INVALID_CHARS, text, -1, wide, 1024)) wide[0] = 0;
+    return wide;
+}
+static FILE* open_utf8(const char* path, const char* mode) { return _wfopen(widen(path), widen(mode)); }
+static int make_folder(const char* path) { return _wmkdir(widen(path)) == 0 || errno == EEXIST ? 0 : -1; }
+#else
+#define SEPARATOR '/'
+static FILE* open_utf8(const char* path, const char* mode) { return fopen(path, mode); }
+static int make_folder(const char* path) { return mkdir(path, 0777) == 0 || errno == EEXIST ? 0 : -1; }
+#endif
+
+/* Whether the file at `path` (UTF-8) starts with `magic`. */
+static int starts_with(const char* path, const char* magic) {
+    char head[16] = {0};
+    size_t length = strlen(magic);
+    FILE* file = open_utf8(path, "rb");
+    if (!file) return 0;
+    length = fread(head, 1, length, file) == length && memcmp(head, magic, length) == 0;
+    fclose(file);
+    return (int)length;
+}
+
+static void test_paths(dqj_context context, const char* scratch_dir) {
+    /* A folder with spaces and letters beyond ASCII ("dqj paths été 日本 🌀"): a parameter file read
+     * from it, a picture, a bake and a mesh written into it twice (the second time over the first). */
+    const char* name = "dqj paths \xc3\xa9t\xc3\xa9 \xe6\x97\xa5\xe6\x9c\xac \xf0\x9f\x8c\x80";
+    char folder[1024], path[1200];
+    const char* outputs[3] = {"picture \xc3\xbc.png", "volume \xc3\xbc.vdb", "mesh \xc3\xbc.ply"};
+    const char* magics[3] = {"\x89PNG", " BDV", "ply\n"};
+    size_t needed = 0;
+    char* json;
+    FILE* file;
+    int pass, index;
+    snprintf(folder, sizeof folder, "%s%c%s", scratch_dir, SEPARATOR, name);
+    CHECK(make_folder(folder) == 0, "cannot make the folder %s", folder);
+    /* The parameter file's name with '/' even on Windows, which takes both separators. */
+    snprintf(path, sizeof path, "%s/params \xc3\xb1.json", folder);
+    file = open_utf8(path, "wb");
+    CHECK(file != NULL, "cannot write %s", path);
+    if (!file) return;
+    fputs("{\"fractal\": {\"iterations\": 7}, \"render\": {\"width\": 32, \"height\": 24}, "
+          "\"bake\": {\"resolution\": 16}}", file);
+    fclose(file);
+    CHECK(dqj_context_load_params_file(context, path) == DQJ_OK, "load %s: %s", path, dqj_context_error(context));
+    CHECK(dqj_context_get_params_json(context, NULL, 0, &needed) == DQJ_OK, "size query");
+    json = (char*)malloc(needed);
+    CHECK(dqj_context_get_params_json(context, json, needed, NULL) == DQJ_OK, "get params");
+    CHECK(strstr(json, "\"iterations\": 7") != NULL, "the file's parameters were not taken: %s", json);
+    free(json);
+    for (pass = 0; pass < 2; ++pass) {
+        snprintf(path, sizeof path, "%s%c%s", folder, SEPARATOR, outputs[0]);
+        CHECK(dqj_render_to_file(context, path, NULL, NULL) == DQJ_OK, "render %s: %s", path, dqj_context_error(context));
+        snprintf(path, sizeof path, "%s%c%s", folder, SEPARATOR, outputs[1]);
+        CHECK(dqj_bake_vdb(context, path, NULL, NULL) == DQJ_OK, "bake %s: %s", path, dqj_context_error(context));
+        snprintf(path, sizeof path, "%s%c%s", folder, SEPARATOR, outputs[2]);
+        CHECK(dqj_mesh_compute(context, NULL, NULL) == DQJ_OK, "mesh: %s", dqj_context_error(context));
+        CHECK(dqj_mesh_write(context, path) == DQJ_OK, "mesh %s: %s", path, dqj_context_error(context));
+    }
+    for (index = 0; index < 3; ++index) {
+        snprintf(path, sizeof path, "%s%c%s", folder, SEPARATOR, outputs[index]);
+        CHECK(starts_with(path, magics[index]), "%s is missing or not what was written", path);
+    }
+    /* A name that is not UTF-8, which no Windows file has, fails with a message (Linux takes any bytes). */
+#ifdef _WIN32
+    snprintf(path, sizeof path, "%s%cbad \xff.png", folder, SEPARATOR);
+    CHECK(dqj_render_to_file(context, path, NULL, NULL) != DQJ_OK && dqj_context_error(context)[0] != '\0',
+          "a name that is not UTF-8 was accepted");
+#endif
+}
+
 int main(int argc, char** argv) {
     dqj_context context = NULL;
     const char* scratch = argc > 1 ? argv[1] : ".";
@@ -254,6 +340,7 @@ int main(int argc, char** argv) {
     test_render(context, scratch);
     test_empty_slice(context);
     test_bake_stats(context);
+    test_paths(context, scratch);
     dqj_context_destroy(context);
     printf("%d passed, %d failed\n", checks - failures, failures);
     return failures == 0 ? 0 : 1;

@@ -73,7 +73,8 @@ private:
 
 /// What this process may still allocate under its own limits: RLIMIT_AS and RLIMIT_DATA
 /// (ulimit -v, ulimit -d) less what it uses, and the memory.max (cgroup v2) or
-/// memory.limit_in_bytes (v1) of its cgroups less their usage. UINT64_MAX when unlimited.
+/// memory.limit_in_bytes (v1) of its cgroups less their usage; on Windows, its job object's limits.
+/// UINT64_MAX when unlimited.
 DQJ_API std::uint64_t processMemoryHeadroom();
 /// Half of the memory the system reports available (MemAvailable) right now, at most
 /// processMemoryHeadroom().

@@ -1,0 +1,90 @@
+"""dqjulia.exe run under Wine as a Windows user runs it, against the Linux build's dqjulia: the
+default picture, a bake and a mesh, each compared with the Linux one by the Linux build's
+compare_outputs (its PNG reader, the Linux OpenVDB); every output named with a drive letter and
+backslashes, in a folder with spaces and letters beyond ASCII; an existing output kept without
+--force and replaced with it; no temporary file left behind.
+
+Usage: python3 cli_test.py WORK LINUX_BUILD DQJULIA_EXE EMULATOR...
+"""
+
+import os
+import shutil
+import subprocess
+import sys
+
+FOLDER = "cli \u00e9t\u00e9 \u65e5\u672c"  # "cli été 日本"
+
+# (name, arguments, compare_outputs kind): the default picture, and a bake and a mesh small enough
+# to be quick under Wine.
+OUTPUTS = (
+    ("fractal.png", ["render", "-q"], "png"),
+    ("fractal.vdb", ["bake", "-q", "-r", "96"], "vdb"),
+    ("fractal.ply", ["mesh", "-q", "-r", "96"], "ply"),
+)
+
+
+def windows_path(path):
+    """A Linux path as a Windows program under Wine names it: drive Z: is /."""
+    return "Z:" + os.path.abspath(path).replace("/", "\\")
+
+
+def run(command):
+    result = subprocess.run(command, capture_output=True, text=True, encoding="utf-8", errors="replace")
+    return result.returncode, result.stdout + result.stderr
+
+
+def skip_or_fail(reason):
+    if os.environ.get("CI") == "true":
+        raise SystemExit("FAIL: %s (CI=true: every test must run)" % reason)
+    print("DQJ_TEST_SKIPPED: %s" % reason)
+    sys.exit(0)
+
+
+def main():
+    work, linux_build, exe, *emulator = sys.argv[1:]
+    linux_cli = os.path.join(linux_build, "bin", "dqjulia")
+    compare = os.path.join(linux_build, "bin", "compare_outputs")
+    for program in (linux_cli, compare):
+        if not os.access(program, os.X_OK):
+            skip_or_fail("%s is missing: build the Linux tree first (scripts/build.sh)" % program)
+    shutil.rmtree(work, ignore_errors=True)
+    linux_dir, windows_dir = os.path.join(work, "linux"), os.path.join(work, FOLDER)
+    os.makedirs(linux_dir)
+    os.makedirs(windows_dir)
+    checks = {}
+
+    for name, arguments, kind in OUTPUTS:
+        linux_file, windows_file = os.path.join(linux_dir, name), os.path.join(windows_dir, name)
+        status, output = run([linux_cli, *arguments, "-o", linux_file])
+        checks["linux dqjulia %s: exit %d %s" % (arguments[0], status, output.strip())] = status == 0
+        status, output = run([*emulator, exe, *arguments, "-o", windows_path(windows_file)])
+        checks["dqjulia.exe %s: exit %d %s" % (arguments[0], status, output.strip())] = status == 0
+        status, output = run([compare, kind, linux_file, windows_file])
+        print("%s, Linux against Windows: %s" % (name, output.strip().replace("\n", "; ")))
+        checks["%s equal on Linux and Windows" % name] = status == 0
+
+    # An existing output is kept without --force (before any work), and replaced with it.
+    picture = windows_path(os.path.join(windows_dir, "fractal.png"))
+    small = ["render", "-q", "-W", "48", "-H", "36", "-o", picture]
+    status, output = run([*emulator, exe, *small])
+    checks["without --force an existing file is kept: exit %d %s" % (status, output.strip())] = (
+        status == 2 and "exists; pass --force" in output
+    )
+    status, output = run([*emulator, exe, *small, "--force"])
+    checks["with --force it is replaced: exit %d %s" % (status, output.strip())] = status == 0
+    status, output = run([compare, "png", os.path.join(linux_dir, "fractal.png"), os.path.join(windows_dir, "fractal.png")])
+    checks["the replaced picture is the new one (48x36)"] = status == 1 and "sizes differ" in output
+
+    names = sorted(os.listdir(windows_dir))
+    checks["the folder holds the outputs and nothing else (no temporary file): %s" % names] = names == sorted(
+        name for name, _, _ in OUTPUTS
+    )
+    for name, ok in checks.items():
+        print("%s: %s" % ("ok" if ok else "FAIL", name))
+    failed = sum(not ok for ok in checks.values())
+    print("%d passed, %d failed" % (len(checks) - failed, failed))
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
