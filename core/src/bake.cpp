@@ -30,6 +30,7 @@
 #include "atomic_file.hpp"
 #include "level_set.hpp"
 #include "parallel_progress.hpp"
+#include "thread_scratch.hpp"
 
 namespace dqj {
 
@@ -116,13 +117,14 @@ void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, 
     const Slice slice = params.slice.effective();
     const double h = surface.voxelSize()[0];
     std::atomic<std::uint64_t> evaluated{0};
+    ThreadScratch<BatchBuffer<double>> batches;  // a leaf's active voxels through the SIMD kernel together
     parallelForWithProgress(leaves.size(), progress, [&](std::size_t index, const std::atomic<bool>& stop) {
         const auto& leaf = *leaves[index];
         auto colorLeaf = color ? std::make_unique<ColorLeaf>(leaf.origin(), openvdb::Vec3s(0.0f), false) : nullptr;
         auto trapLeaf = trap ? std::make_unique<FloatLeaf>(leaf.origin(), 0.0f, false) : nullptr;
         auto iterationLeaf = iterations ? std::make_unique<FloatLeaf>(leaf.origin(), 0.0f, false) : nullptr;
         if (stop.load(std::memory_order_relaxed)) return;
-        thread_local BatchBuffer<double> batch;  // the leaf's active voxels through the SIMD kernel together
+        BatchBuffer<double>& batch = batches.local();
         batch.clear();
         for (auto voxel = leaf.cbeginValueOn(); voxel; ++voxel) {
             const openvdb::Coord ijk = voxel.getCoord();

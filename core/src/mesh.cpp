@@ -20,6 +20,7 @@
 #include "dqjulia/coloring.hpp"
 #include "level_set.hpp"
 #include "parallel_progress.hpp"
+#include "thread_scratch.hpp"
 
 namespace dqj {
 namespace {
@@ -250,11 +251,12 @@ Mesh bakeMesh(const Params& params, const BakeOptions& options, const ProgressCa
         mesh.colors.resize(mesh.positions.size());
         const Slice slice = params.slice.effective();
         const std::size_t tasks = (mesh.positions.size() + kVerticesPerTask - 1) / kVerticesPerTask;
+        ThreadScratch<BatchBuffer<double>> batches;  // a task's vertices through the SIMD kernel together
         parallelForWithProgress(
             tasks, staged.stage(BakeStage::Meshing, 0.9, 1.0), [&](std::size_t task, const std::atomic<bool>&) {
                 const std::size_t first = task * kVerticesPerTask;
                 const std::size_t end = std::min(mesh.positions.size(), (task + 1) * kVerticesPerTask);
-                thread_local BatchBuffer<double> batch;  // the task's vertices through the SIMD kernel together
+                BatchBuffer<double>& batch = batches.local();
                 batch.clear();
                 for (std::size_t index = first; index < end; ++index)
                     batch.add(slice.map(glm::dvec3(mesh.positions[index])));

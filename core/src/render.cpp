@@ -24,6 +24,7 @@
 #include <glm/geometric.hpp>
 
 #include "parallel_progress.hpp"
+#include "thread_scratch.hpp"
 
 namespace dqj {
 namespace {
@@ -558,7 +559,14 @@ struct TileStats {
     std::uint64_t hitPixels = 0;
 };
 
-TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, int x1, int y1, Image& image) {
+/// A thread's rays in flight and their evaluator, reused from tile to tile.
+struct TileScratch {
+    Evaluator evaluator;
+    std::vector<RayJob> jobs;
+};
+
+TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, int x1, int y1, Image& image,
+                     TileScratch& scratch) {
     TileStats stats;
     const CameraFrame& camera = scene.camera();
     const int samples = scene.samples();
@@ -568,8 +576,8 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
     const int pixels = width * (y1 - y0);
     // The tile's pixels go through in passes of about kRaysPerPass rays, whole pixels at a time.
     const int pixelsPerPass = std::max(1, kRaysPerPass / perPixel);
-    thread_local Evaluator evaluator;
-    thread_local std::vector<RayJob> jobs;
+    Evaluator& evaluator = scratch.evaluator;
+    std::vector<RayJob>& jobs = scratch.jobs;
     for (int first = 0; first < pixels; first += pixelsPerPass) {
         const int last = std::min(pixels, first + pixelsPerPass);
         jobs.clear();
@@ -686,13 +694,14 @@ RenderResult render(const Params& params, const ProgressCallback& progress, Rend
     std::atomic<std::uint64_t> rays{0};
     std::atomic<std::uint64_t> steps{0};
     std::atomic<std::uint64_t> hitPixels{0};
+    ThreadScratch<TileScratch> scratch;
     parallelForWithProgress(static_cast<std::size_t>(tilesX) * tilesY, progress,
                             [&](std::size_t index, const std::atomic<bool>&) {
                                 const int x0 = static_cast<int>(index % tilesX) * kTileSize;
                                 const int y0 = static_cast<int>(index / tilesX) * kTileSize;
                                 const TileStats tile =
                                     renderTile(scene, engine, x0, y0, std::min(x0 + kTileSize, image.width),
-                                               std::min(y0 + kTileSize, image.height), image);
+                                               std::min(y0 + kTileSize, image.height), image, scratch.local());
                                 rays += tile.rays;
                                 steps += tile.steps;
                                 hitPixels += tile.hitPixels;

@@ -430,8 +430,9 @@ float SurfaceFunction::value(int n, double de, double regionDistance) const {
 
 void SurfaceFunction::operator()(const glm::dvec3* points, std::size_t count, float* values,
                                  std::uint64_t& evaluations) const {
-    thread_local BatchBuffer<double> batch;
-    thread_local std::vector<std::size_t> evaluated;  // indices of the points inside the region
+    BatchScratch& scratch = scratch_.local();
+    BatchBuffer<double>& batch = scratch.batch;
+    std::vector<std::size_t>& evaluated = scratch.evaluated;
     batch.clear();
     evaluated.clear();
     for (std::size_t i = 0; i < count; ++i) {

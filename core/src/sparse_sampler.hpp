@@ -20,9 +20,11 @@
 #include <openvdb/openvdb.h>
 
 #include "dqjulia/bake.hpp"
+#include "dqjulia/batch.hpp"
 #include "dqjulia/params.hpp"
 #include "dqjulia/slice.hpp"
 #include "staged_progress.hpp"
+#include "thread_scratch.hpp"
 
 namespace dqj {
 
@@ -67,6 +69,12 @@ public:
 private:
     float value(int n, double de, double regionDistance) const;  ///< f from an escape count and DE
 
+    /// A thread's batch for the SIMD kernel and the indices of its points inside the region.
+    struct BatchScratch {
+        BatchBuffer<double> batch;
+        std::vector<std::size_t> evaluated;
+    };
+
     Fractal fractal_;
     Slice slice_;
     BakeRegion region_;
@@ -74,6 +82,7 @@ private:
     double epsilon_;
     double stretch_ = 1.0, stretchA_ = 1.0, stretchB_ = 0.0;
     float background_;
+    mutable ThreadScratch<BatchScratch> scratch_;
 };
 
 /// What the sampling produced: f on a FloatGrid (transform: voxel size h, voxel (i, j, k) at
