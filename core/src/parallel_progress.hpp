@@ -18,10 +18,28 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
 
 #include "dqjulia/progress.hpp"
 
 namespace dqj {
+
+/// Windows: TBB ends its scheduler, joining its worker threads, when the last thread that used it
+/// exits. Each call below runs the work from a thread of its own, so that would happen at the end
+/// of every call, inside that thread's exit; with the MinGW build that wait never ends (seen under
+/// Wine: every render or bake with a callback hung; likely the loader lock thread exits hold).
+/// An arena kept for the life of the process keeps the scheduler, so no thread exit ends it.
+/// Elsewhere the scheduler ends and restarts safely, and nothing is kept.
+inline void keepSchedulerAlive() {
+#ifdef _WIN32
+    static tbb::task_arena* const kept = [] {
+        auto* arena = new tbb::task_arena();  // never deleted: the process's exit ends its threads
+        arena->initialize();
+        return arena;
+    }();
+    (void)kept;
+#endif
+}
 
 /// One work item. `stop` becomes true when the user cancelled or another item failed;
 /// long items should poll it and return early (short ones may ignore it: items not yet
@@ -64,6 +82,7 @@ inline void parallelForWithProgress(std::size_t count, const ProgressCallback& p
     }
 
     if (!progress(0.0)) throw Cancelled();  // lets a caller cancel even work shorter than 100 ms
+    keepSchedulerAlive();
 
     std::mutex mutex;
     std::condition_variable finishedSignal;
