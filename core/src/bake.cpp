@@ -19,6 +19,8 @@
 #include <unistd.h>
 
 #include <openvdb/io/File.h>
+#include <openvdb/tools/FastSweeping.h>
+#include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/LevelSetRebuild.h>
 #include <openvdb/tools/LevelSetUtil.h>
 #include <openvdb/tools/Morphology.h>
@@ -95,66 +97,66 @@ openvdb::MaskTree attributeVoxels(const openvdb::FloatGrid& surface, const BakeS
     return mask;
 }
 
-/// The attribute grids ("color", "trap", "iterations") on attributeVoxels(): one fractal
-/// evaluation a voxel; colour and smooth count from coloring.hpp.
+/// The attribute grids ("color", "trap", "iterations") on attributeVoxels(), each an extension
+/// field: every voxel holds the value at the surface point nearest to it (OpenVDB's fast
+/// sweeping, along the distance's gradient), so the inside shows, through the depth light
+/// reaches, the colour its surface has, as the mesh's vertices and the preview do; a voxel's own
+/// orbit would give the inside's colour instead (bounded orbits: the palette's far end). One
+/// fractal evaluation a surface crossing (about the band's voxels that touch the surface), then
+/// a sweep over the voxels; colour and smooth count from coloring.hpp.
 void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, const ProgressCallback& progress,
                        BakeStats& stats, openvdb::GridPtrVec& grids) {
     const bool color = hasGrid(params.bake, BakeGrid::Color);
     const bool trap = hasGrid(params.bake, BakeGrid::Trap);
     const bool iterations = hasGrid(params.bake, BakeGrid::Iterations);
     if (!color && !trap && !iterations) return;
-    const openvdb::MaskTree voxels = attributeVoxels(surface, params.bake);
-    std::vector<const openvdb::MaskTree::LeafNodeType*> leaves;
-    voxels.getNodes(leaves);
-    std::vector<std::unique_ptr<ColorLeaf>> colorLeaves(color ? leaves.size() : 0);
-    std::vector<std::unique_ptr<FloatLeaf>> trapLeaves(trap ? leaves.size() : 0);
-    std::vector<std::unique_ptr<FloatLeaf>> iterationLeaves(iterations ? leaves.size() : 0);
+    if (progress && !progress(0.0)) throw Cancelled();
+    // The level set's distances over the attribute voxels (its band stops short of their depth).
+    openvdb::MaskGrid voxels(std::make_shared<openvdb::MaskTree>(attributeVoxels(surface, params.bake)));
+    voxels.setTransform(surface.transform().copy());
+    const openvdb::FloatGrid::Ptr distance = openvdb::tools::maskSdf(surface, voxels);
     const Slice slice = params.slice.effective();
-    const double h = surface.voxelSize()[0];
     std::atomic<std::uint64_t> evaluated{0};
-    parallelForWithProgress(leaves.size(), progress, [&](std::size_t index, const std::atomic<bool>& stop) {
-        const auto& leaf = *leaves[index];
-        auto colorLeaf = color ? std::make_unique<ColorLeaf>(leaf.origin(), openvdb::Vec3s(0.0f), false) : nullptr;
-        auto trapLeaf = trap ? std::make_unique<FloatLeaf>(leaf.origin(), 0.0f, false) : nullptr;
-        auto iterationLeaf = iterations ? std::make_unique<FloatLeaf>(leaf.origin(), 0.0f, false) : nullptr;
-        if (stop.load(std::memory_order_relaxed)) return;
-        thread_local BatchBuffer<double> batch;  // the leaf's active voxels through the SIMD kernel together
-        batch.clear();
-        for (auto voxel = leaf.cbeginValueOn(); voxel; ++voxel) {
-            const openvdb::Coord ijk = voxel.getCoord();
-            batch.add(slice.map(glm::dvec3(ijk.x(), ijk.y(), ijk.z()) * h));
-        }
-        batch.evaluate(params.fractal);
-        std::uint64_t count = 0;
-        for (auto voxel = leaf.cbeginValueOn(); voxel; ++voxel) {
-            const Escape escape = batch.escape(count++);
-            if (colorLeaf) {
-                const glm::dvec3 rgb = orbitColour(params.material, params.fractal, escape);
-                colorLeaf->setValueOn(voxel.pos(), openvdb::Vec3s(float(rgb.x), float(rgb.y), float(rgb.z)));
-            }
-            if (trapLeaf) trapLeaf->setValueOn(voxel.pos(), float(escape.trap));
-            if (iterationLeaf) iterationLeaf->setValueOn(voxel.pos(), float(smoothIterations(params.fractal, escape)));
-        }
-        evaluated += count;
-        if (colorLeaf) colorLeaves[index] = std::move(colorLeaf);
-        if (trapLeaf) trapLeaves[index] = std::move(trapLeaf);
-        if (iterationLeaf) iterationLeaves[index] = std::move(iterationLeaf);
-    });
-    stats.evaluated += evaluated.load();
-
-    auto assemble = [&](auto& parts, auto grid, const char* name) {
-        for (auto& leaf : parts) grid->tree().addLeaf(leaf.release());
+    // OpenVDB 10's sweep passes the functors index coordinates (it takes the transform of the
+    // extension grid it creates, which has none); the bake's grid is index * voxel size. The
+    // orbit is taken kSurfaceColourOffset voxels outside, along the distance's gradient.
+    const double h = surface.voxelSize()[0];
+    auto atSurface = [&](const openvdb::Vec3R& ijk) {
+        ++evaluated;
+        auto at = [&](double x, double y, double z) {
+            return double(openvdb::tools::BoxSampler::sample(surface.tree(), ijk + openvdb::Vec3R(x, y, z)));
+        };
+        glm::dvec3 gradient(at(0.5, 0, 0) - at(-0.5, 0, 0), at(0, 0.5, 0) - at(0, -0.5, 0), at(0, 0, 0.5) - at(0, 0, -0.5));
+        const double length = glm::length(gradient);
+        if (length > 0.0) gradient /= length;
+        const glm::dvec3 p = glm::dvec3(ijk.x(), ijk.y(), ijk.z()) + kSurfaceColourOffset * gradient;
+        return evaluate(params.fractal, slice.map(p * h));
+    };
+    auto name = [&](auto grid, const char* label) {
         grid->setTransform(surface.transform().copy());
-        grid->setName(name);
+        grid->setName(label);
         grid->setGridClass(openvdb::GRID_UNKNOWN);
         grids.push_back(grid);
         return grid;
     };
-    if (color)
-        assemble(colorLeaves, openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f)), "color")
-            ->setVectorType(openvdb::VEC_INVARIANT);
-    if (trap) assemble(trapLeaves, openvdb::FloatGrid::create(0.0f), "trap");
-    if (iterations) assemble(iterationLeaves, openvdb::FloatGrid::create(0.0f), "iterations");
+    if (color) {
+        auto rgb = [&](const openvdb::Vec3R& xyz) {
+            const glm::dvec3 c = orbitColour(params.material, params.fractal, atSurface(xyz));
+            return openvdb::Vec3s(float(c.x), float(c.y), float(c.z));
+        };
+        name(openvdb::tools::sdfToExt(*distance, rgb, openvdb::Vec3s(0.0f)), "color")->setVectorType(openvdb::VEC_INVARIANT);
+        if (progress && !progress(0.5)) throw Cancelled();
+    }
+    if (trap) {
+        auto value = [&](const openvdb::Vec3R& xyz) { return float(atSurface(xyz).trap); };
+        name(openvdb::tools::sdfToExt(*distance, value, 0.0f), "trap");
+    }
+    if (iterations) {
+        auto value = [&](const openvdb::Vec3R& xyz) { return float(smoothIterations(params.fractal, atSurface(xyz))); };
+        name(openvdb::tools::sdfToExt(*distance, value, 0.0f), "iterations");
+    }
+    stats.evaluated += evaluated.load();
+    if (progress && !progress(1.0)) throw Cancelled();
 }
 
 }  // namespace

@@ -16,6 +16,12 @@
 
 namespace dqj {
 
+/// Bakes take a surface point's colour (and trap, iteration count) this many voxels outside it,
+/// along its normal, where the renderer and the preview take theirs (their hits lie outside the
+/// finite-N set): on the surface itself an orbit is bounded (the inside's colour, the palette's
+/// other end) about as often as not.
+constexpr double kSurfaceColourOffset = 0.5;
+
 /// Registers OpenVDB's grid types once (thread-safe).
 void initializeOpenVdb();
 
