@@ -126,7 +126,8 @@ void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, 
         auto at = [&](double x, double y, double z) {
             return double(openvdb::tools::BoxSampler::sample(surface.tree(), ijk + openvdb::Vec3R(x, y, z)));
         };
-        glm::dvec3 gradient(at(0.5, 0, 0) - at(-0.5, 0, 0), at(0, 0.5, 0) - at(0, -0.5, 0), at(0, 0, 0.5) - at(0, 0, -0.5));
+        glm::dvec3 gradient(at(0.5, 0, 0) - at(-0.5, 0, 0), at(0, 0.5, 0) - at(0, -0.5, 0),
+                            at(0, 0, 0.5) - at(0, 0, -0.5));
         const double length = glm::length(gradient);
         if (length > 0.0) gradient /= length;
         const glm::dvec3 p = glm::dvec3(ijk.x(), ijk.y(), ijk.z()) + kSurfaceColourOffset * gradient;
@@ -144,7 +145,8 @@ void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, 
             const glm::dvec3 c = orbitColour(params.material, params.fractal, atSurface(xyz));
             return openvdb::Vec3s(float(c.x), float(c.y), float(c.z));
         };
-        name(openvdb::tools::sdfToExt(*distance, rgb, openvdb::Vec3s(0.0f)), "color")->setVectorType(openvdb::VEC_INVARIANT);
+        name(openvdb::tools::sdfToExt(*distance, rgb, openvdb::Vec3s(0.0f)), "color")
+            ->setVectorType(openvdb::VEC_INVARIANT);
         if (progress && !progress(0.5)) throw Cancelled();
     }
     if (trap) {
