@@ -29,7 +29,7 @@ def farm_dir(obj, context=None):
 
 
 class DQJULIA_OT_farm_bake(bpy.types.Operator):
-    """Bake frames of a DQ Julia object's sequence into a shared folder, blocking (for farm tasks; skips finished frames)"""
+    """Bake frames of a DQ Julia object's sequence into a shared folder, blocking (farm tasks; skips finished ones)"""
 
     bl_idname = "dqjulia.farm_bake"
     bl_label = "Farm Bake"

@@ -495,7 +495,7 @@ def sequence_tasks(obj, scene, frames, directory):
             with native.Context() as context:
                 context.set_params(document)
         except native.NativeError as error:
-            raise ValueError("frame %d: %s" % (frame, error.message))
+            raise ValueError("frame %d: %s" % (frame, error.message)) from None
     return [
         jobs.VolumeTask(document, bakes.sequence_frame_path(directory, obj, frame), frame=frame)
         for frame, document in zip(frames, documents)

@@ -58,9 +58,9 @@ void BakeFlags::addTo(CLI::App& command, BakeCommand kind) {
     fractal.addTo(command);
     command
         .add_option("-o,--output", output,
-                    mesh                          ? "Output mesh: .ply (binary) or .obj"
+                    mesh                        ? "Output mesh: .ply (binary) or .obj"
                     : kind == BakeCommand::Farm ? "The bake's output file (.vdb), on storage every machine shares"
-                                                  : "Output OpenVDB file (.vdb)")
+                                                : "Output OpenVDB file (.vdb)")
         ->required();
     command
         .add_option("-r,--resolution", resolution,
@@ -99,8 +99,9 @@ void BakeFlags::addTo(CLI::App& command, BakeCommand kind) {
         command.add_option("--tile", tile, "With --tiles: bake tile K alone (default: every tile, one after another)");
     command.add_option("--max-memory", maxMemory,
                        "Refuse when the estimate exceeds this, e.g. 4G or 512M (default: half the available memory)");
-    command.add_option("--threads", threads,
-                       "Threads to use (default: SLURM_CPUS_PER_TASK, else the CPUs this process may run on)")
+    command
+        .add_option("--threads", threads,
+                    "Threads to use (default: SLURM_CPUS_PER_TASK, else the CPUs this process may run on)")
         ->check(CLI::Range(1, 4096));
     command.add_flag("--skip-existing", skipExisting,
                      "Skip the frames (and tiles) whose output file exists: they are complete, since files get their "

@@ -34,7 +34,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-constexpr int kMaxOpenJdChunks = 1024;  // a task parameter's list holds at most 1024 values
+constexpr int kMaxOpenJdChunks = 1024;    // a task parameter's list holds at most 1024 values
 constexpr int kSlurmMaxArraySize = 1001;  // Slurm's default MaxArraySize
 
 struct FarmFlags {
@@ -88,7 +88,9 @@ std::string lowercaseExtension(const std::string& path) {
     return extension;
 }
 
-std::string withoutExtension(const std::string& path) { return (fs::path(path).parent_path() / fs::path(path).stem()).string(); }
+std::string withoutExtension(const std::string& path) {
+    return (fs::path(path).parent_path() / fs::path(path).stem()).string();
+}
 
 /// `path` relative to the folder of `file`.
 std::string relativeTo(const std::string& path, const std::string& file) {
@@ -165,8 +167,8 @@ std::string slurmBakeScript(const FarmFlags& flags, const FarmPlan& plan) {
     const int tasks = plan.chunks() * plan.tiles();
     text << sbatchHeader(flags, plan, plan.name, tasks,
                          "Bakes " + plan.describe() + ": " + std::to_string(tasks) + " array tasks.");
-    text << chunkLines(plan, plan.tiling ? "SLURM_ARRAY_TASK_ID / " + std::to_string(plan.tiles())
-                                         : "SLURM_ARRAY_TASK_ID");
+    text << chunkLines(plan,
+                       plan.tiling ? "SLURM_ARRAY_TASK_ID / " + std::to_string(plan.tiles()) : "SLURM_ARRAY_TASK_ID");
     text << "exec " << shellQuote(plan.dqjulia) << " bake -p " << shellQuote(plan.paramsPath);
     if (plan.frames) text << " --frames \"$first-$last\"";
     if (plan.tiling)
@@ -197,8 +199,8 @@ std::string runCapturing(const std::string& command) {
     while (std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
     const int status = ::pclose(pipe);
     if (status != 0)
-        throw std::runtime_error(command + " failed (exit " + std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) +
-                                 "): " + output);
+        throw std::runtime_error(command + " failed (exit " +
+                                 std::to_string(WIFEXITED(status) ? WEXITSTATUS(status) : -1) + "): " + output);
     return output;
 }
 
@@ -232,7 +234,8 @@ int runSlurm(const FarmFlags& flags) {
     id = id.substr(0, id.find_first_of(";\n"));
     std::cout << "submitted " << script << " as job " << id << "\n";
     if (job.tiling) {
-        std::string merge = runCapturing("sbatch --parsable --dependency=afterok:" + id + " " + shellQuote(mergeScript));
+        std::string merge =
+            runCapturing("sbatch --parsable --dependency=afterok:" + id + " " + shellQuote(mergeScript));
         merge = merge.substr(0, merge.find_first_of(";\n"));
         std::cout << "submitted " << mergeScript << " as job " << merge << " (after job " << id << ")\n";
     }
@@ -265,13 +268,13 @@ nlohmann::ordered_json openJdStep(const std::string& name, const FarmPlan& plan,
 }
 
 int runOpenJd(const FarmFlags& flags) {
-    const std::string file = flags.file.empty()
-                                 ? withoutExtension(fs::absolute(flags.bake.output).string()) + ".openjd.json"
-                                 : flags.file;
+    const std::string file =
+        flags.file.empty() ? withoutExtension(fs::absolute(flags.bake.output).string()) + ".openjd.json" : flags.file;
     FarmPlan job = plan(flags, "--template", file);
     if (job.chunks() > kMaxOpenJdChunks)
-        throw ParamError("frames", std::to_string(job.chunks()) + " chunks of frames: an Open Job Description task "
-                                                                 "parameter holds at most " +
+        throw ParamError("frames", std::to_string(job.chunks()) +
+                                       " chunks of frames: an Open Job Description task "
+                                       "parameter holds at most " +
                                        std::to_string(kMaxOpenJdChunks) + " values; raise --chunk");
     nlohmann::ordered_json document = {
         {"specificationVersion", "jobtemplate-2023-09"},
@@ -320,19 +323,22 @@ void addCommonFlags(CLI::App& command, FarmFlags& flags) {
 Runner addFarmCommand(CLI::App& app) {
     auto slurm = std::make_shared<FarmFlags>();
     auto openjd = std::make_shared<FarmFlags>();
-    CLI::App* farm = app.add_subcommand(
-        "farm", "Write the job files that bake frames (and tiles) on a farm: Slurm, Open Job Description");
+    CLI::App* farm =
+        app.add_subcommand("farm",
+                           "Write the job files that bake frames (and tiles) on a farm: Slurm, Open Job Description");
     farm->require_subcommand(1);
     CLI::App* slurmCommand =
         farm->add_subcommand("slurm", "An sbatch array script (and a dependent merge job for --tiles)");
     addCommonFlags(*slurmCommand, *slurm);
-    slurmCommand->add_option("--script", slurm->file, "The array script to write (default: NAME.slurm beside --output)");
+    slurmCommand->add_option("--script", slurm->file,
+                             "The array script to write (default: NAME.slurm beside --output)");
     slurmCommand->add_option("--cpus-per-task", slurm->cpus, "CPUs a task gets, and the threads it uses (default 1)")
         ->check(CLI::Range(1, 4096));
     slurmCommand->add_option("--partition", slurm->partition, "sbatch --partition");
     slurmCommand->add_option("--time", slurm->time, "sbatch --time, a task's time limit");
     slurmCommand->add_option("--mem", slurm->memory, "sbatch --mem, a task's memory");
-    slurmCommand->add_option("--sbatch", slurm->sbatchOptions, "Another #SBATCH line, e.g. --sbatch=--qos=low (repeatable)");
+    slurmCommand->add_option("--sbatch", slurm->sbatchOptions,
+                             "Another #SBATCH line, e.g. --sbatch=--qos=low (repeatable)");
     slurmCommand->add_flag("--submit", slurm->submit, "Submit the job(s) with sbatch");
     CLI::App* openjdCommand = farm->add_subcommand(
         "openjd", "An Open Job Description job template: frame chunks as a task parameter, tiles and a merge step");
@@ -340,9 +346,10 @@ Runner addFarmCommand(CLI::App& app) {
     openjdCommand->add_option("--template", openjd->file,
                               "The job template to write (default: NAME.openjd.json beside --output)");
     for (CLI::App* command : {slurmCommand, openjdCommand})
-        command->footer("The tasks' exit status: 0 done; 1 failed while working, a retry may help; 2 bad input, a "
-                        "retry cannot help; 130 interrupted (preempted), a retry helps. Retried or resubmitted "
-                        "tasks skip the files that exist.");
+        command->footer(
+            "The tasks' exit status: 0 done; 1 failed while working, a retry may help; 2 bad input, a "
+            "retry cannot help; 130 interrupted (preempted), a retry helps. Retried or resubmitted "
+            "tasks skip the files that exist.");
     return [slurm, openjd, slurmCommand, openjdCommand] {
         if (slurmCommand->parsed()) return reportErrors("farm slurm", [&] { return runSlurm(*slurm); });
         return reportErrors("farm openjd", [&] { return runOpenJd(*openjd); });

@@ -44,7 +44,8 @@ int runMerge(const MergeFlags& flags) {
         std::string missing;
         for (const std::string& input : inputs)
             if (!std::filesystem::is_regular_file(input)) missing += (missing.empty() ? "'" : ", '") + input + "'";
-        if (!missing.empty()) throw ParamError("tiles", "no tile " + missing + ": bake it first (dqjulia bake --tiles)");
+        if (!missing.empty())
+            throw ParamError("tiles", "no tile " + missing + ": bake it first (dqjulia bake --tiles)");
         checkOutputPath(path, bake.force);
         merges.emplace_back(path, std::move(inputs));
     }
@@ -83,8 +84,9 @@ Runner addMergeCommand(CLI::App& app) {
                         "Instead of naming the tiles: merge NAME.tile_1.vdb ... of this AxBxC tiling beside --output");
     command->add_option("--frames", flags->bake.frames,
                         "With --tiles: merge frames FIRST-LAST, NAME_0001.tile_K.vdb into NAME_0001.vdb, ...");
-    command->add_option("--threads", flags->bake.threads,
-                        "Threads to use (default: SLURM_CPUS_PER_TASK, else the CPUs this process may run on)")
+    command
+        ->add_option("--threads", flags->bake.threads,
+                     "Threads to use (default: SLURM_CPUS_PER_TASK, else the CPUs this process may run on)")
         ->check(CLI::Range(1, 4096));
     command->add_flag("--skip-existing", flags->bake.skipExisting, "Skip the outputs that exist: they are complete");
     command->add_flag("-f,--force", flags->bake.force, "Overwrite existing output files");

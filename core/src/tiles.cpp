@@ -141,8 +141,8 @@ void checkTilesBelongTogether(const std::vector<TileHeader>& headers) {
     if (missingCount > 0)
         throw ParamError("tiles", std::to_string(missingCount) + " of the " + std::to_string(count) + " tiles of " +
                                       tilingText(first.tile) + " are missing: " + missing +
-                                      (missingCount > 10 ? ", ..." : "") + " (given " +
-                                      std::to_string(headers.size()) + " files)");
+                                      (missingCount > 10 ? ", ..." : "") + " (given " + std::to_string(headers.size()) +
+                                      " files)");
     // Each tile's box was checked against its index; together they cover the box once.
     std::uint64_t voxels = 0;
     for (const TileHeader& header : headers) voxels += header.owned.volume();
@@ -166,7 +166,8 @@ Tile parseTiling(const std::string& text) {
         ok = ok && tile.counts[axis] >= 1 && tile.counts[axis] <= kMaxTilesPerAxis;
     }
     if (!ok || position != text.size())
-        throw ParamError("tiles", "tiles \"" + printableText(text) + "\": expected AxBxC, tiles along x, y and z from 1 to " +
+        throw ParamError("tiles", "tiles \"" + printableText(text) +
+                                      "\": expected AxBxC, tiles along x, y and z from 1 to " +
                                       std::to_string(kMaxTilesPerAxis) + " each, e.g. 2x2x2");
     return tile;
 }

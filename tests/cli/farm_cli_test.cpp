@@ -57,8 +57,8 @@ TEST_F(FarmCli, TilesMergeIntoTheOnePieceBakesFile) {
     for (int index = 1; index <= 6; ++index)
         EXPECT_TRUE(fs::is_regular_file(path("tiled.tile_" + std::to_string(index) + ".vdb"))) << index;
     // By name (any order), or by the tiling beside --output.
-    const auto named = run("merge --stats " + quoted("tiled.tile_6.vdb") + " " + path("tiled.tile_[1-5].vdb") +
-                           " -o " + quoted("named.vdb"));  // the shell expands the pattern, as a user's does
+    const auto named = run("merge --stats " + quoted("tiled.tile_6.vdb") + " " + path("tiled.tile_[1-5].vdb") + " -o " +
+                           quoted("named.vdb"));  // the shell expands the pattern, as a user's does
     ASSERT_EQ(named.exitCode, 0) << named.err;
     EXPECT_NE(named.out.find("tiles 6\n"), std::string::npos) << named.out;
     const auto byTiling = run("merge -q --tiles 3x2x1 -o " + quoted("tiled.vdb"));
@@ -77,7 +77,8 @@ TEST_F(FarmCli, FramesOfTilesMergeFrameByFrame) {
     ASSERT_EQ(run("bake " + flags + "-o " + quoted("whole.vdb")).exitCode, 0);
     ASSERT_EQ(run("bake " + flags + "--tiles 1x2x2 -o " + quoted("seq.vdb")).exitCode, 0);
     EXPECT_TRUE(fs::is_regular_file(path("seq_0003.tile_4.vdb")));
-    const auto merged = run("merge -q --tiles 1x2x2 " + flags.substr(flags.find("--frames")) + "-o " + quoted("seq.vdb"));
+    const auto merged =
+        run("merge -q --tiles 1x2x2 " + flags.substr(flags.find("--frames")) + "-o " + quoted("seq.vdb"));
     ASSERT_EQ(merged.exitCode, 0) << merged.err;
     for (const char* frame : {"_0002.vdb", "_0003.vdb"})
         EXPECT_EQ(withoutFileId(path(std::string("seq") + frame)), withoutFileId(path(std::string("whole") + frame)));
@@ -115,8 +116,9 @@ TEST_F(FarmCli, SkipExistingRedoesOnlyWhatIsMissing) {
 TEST_F(FarmCli, ThreadsAndExitCodesAreTheSchedulersToRead) {
     const auto one = run("bake -q -r 24 --threads 1 -o " + quoted("t1.vdb"));
     ASSERT_EQ(one.exitCode, 0) << one.err;
-    const auto slurm = dqj::test::runCommand("/usr/bin/env", std::string("SLURM_CPUS_PER_TASK=2 '") + DQJ_CLI +
-                                                                  "' bake -q -r 24 -o " + quoted("t2.vdb"),
+    const auto slurm = dqj::test::runCommand("/usr/bin/env",
+                                             std::string("SLURM_CPUS_PER_TASK=2 '") + DQJ_CLI + "' bake -q -r 24 -o " +
+                                                 quoted("t2.vdb"),
                                              dir_);
     ASSERT_EQ(slurm.exitCode, 0) << slurm.err;
     EXPECT_EQ(withoutFileId(path("t1.vdb")), withoutFileId(path("t2.vdb")));  // threads change no result

@@ -155,22 +155,20 @@ TEST_P(TilesMerge, EqualTheOnePieceBakeVoxelForVoxel) {
     EXPECT_EQ(merged.activeVoxels, whole.activeVoxels);
     const Comparison comparison = compareFiles(path("whole.vdb"), path("merged.vdb"));
     EXPECT_EQ(comparison.differences, 0u);
-    std::printf("[ figures  ] %s: %s tiles of %d^3, band %g: %llu voxels compared (%llu active), %llu differ\n",
-                c.name, c.tiling, c.resolution, c.band, static_cast<unsigned long long>(comparison.voxels),
+    std::printf("[ figures  ] %s: %s tiles of %d^3, band %g: %llu voxels compared (%llu active), %llu differ\n", c.name,
+                c.tiling, c.resolution, c.band, static_cast<unsigned long long>(comparison.voxels),
                 static_cast<unsigned long long>(comparison.active),
                 static_cast<unsigned long long>(comparison.differences));
 }
 
 // The default bake's index box at 64^3 is 69 voxels a side from -34: halves split at 0 (on a
 // leaf boundary), thirds at -11 and 12 (not); at 128^3, 133 voxels from -66, thirds at -22, 22.
-INSTANTIATE_TEST_SUITE_P(Tilings, TilesMerge,
-                         ::testing::Values(Case{"aligned", 64, 3.0, "2x2x2", false, true},
-                                           Case{"unaligned", 64, 3.0, "3x2x1", false, true},
-                                           Case{"band1", 64, 1.0, "3x1x1", false, false},
-                                           Case{"band6", 64, 6.0, "1x3x1", false, false},
-                                           Case{"dual", 64, 3.0, "1x1x3", true, false},
-                                           Case{"r128", 128, 3.0, "3x1x1", false, false}),
-                         [](const auto& info) { return std::string(info.param.name); });
+INSTANTIATE_TEST_SUITE_P(
+    Tilings, TilesMerge,
+    ::testing::Values(Case{"aligned", 64, 3.0, "2x2x2", false, true}, Case{"unaligned", 64, 3.0, "3x2x1", false, true},
+                      Case{"band1", 64, 1.0, "3x1x1", false, false}, Case{"band6", 64, 6.0, "1x3x1", false, false},
+                      Case{"dual", 64, 3.0, "1x1x3", true, false}, Case{"r128", 128, 3.0, "3x1x1", false, false}),
+    [](const auto& info) { return std::string(info.param.name); });
 
 TEST_F(Tiles, EachTileKeepsOnlyItsBoxAndSaysWhichItIs) {
     Params params;
