@@ -316,4 +316,10 @@ void checkWritable(const std::string& path, Existing existing) {
     AtomicFile probe(path, existing);  // creates (and on destruction discards) a real temporary file there
 }
 
+void writeTextFile(const std::string& path, const std::string& text, Existing existing) {
+    AtomicFile file(path, existing);
+    file.stream() << text;
+    file.commit();
+}
+
 }  // namespace dqj

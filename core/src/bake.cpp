@@ -18,7 +18,6 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
-#include <openvdb/io/File.h>
 #include <openvdb/tools/FastSweeping.h>
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/LevelSetRebuild.h>
@@ -28,6 +27,8 @@
 #include "atomic_file.hpp"
 #include "level_set.hpp"
 #include "parallel_progress.hpp"
+#include "tile_geometry.hpp"
+#include "vdb_file.hpp"
 
 namespace dqj {
 
@@ -44,16 +45,6 @@ public:
 
 private:
     const std::atomic<bool>& stop_;
-};
-
-/// OpenVDB's file writer, aimed at AtomicFile's checked stream. io::File::write opens its own
-/// std::ofstream and never checks it (a full disk gave a truncated file and no error);
-/// Archive's seekable stream writer is what io::File::write calls, so the bytes are the same.
-class CheckedVdbWriter : public openvdb::io::Archive {
-public:
-    void writeTo(std::ostream& out, const openvdb::GridPtrVec& grids, const openvdb::MetaMap& metadata) const {
-        openvdb::io::Archive::write(out, grids, /*seekable=*/true, metadata);
-    }
 };
 
 /// Memory per sampled 8^3 leaf beyond the sampled leaf itself: the rebuild's mesh and distance
@@ -97,21 +88,22 @@ openvdb::MaskTree attributeVoxels(const openvdb::FloatGrid& surface, const BakeS
     return mask;
 }
 
-/// The attribute grids ("color", "trap", "iterations") on attributeVoxels(), each an extension
-/// field: every voxel holds the value at the surface point nearest to it (OpenVDB's fast
-/// sweeping, along the distance's gradient), so the inside shows, through the depth light
-/// reaches, the colour its surface has, as the mesh's vertices and the preview do; a voxel's own
-/// orbit would give the inside's colour instead (bounded orbits: the palette's far end). One
-/// fractal evaluation a surface crossing (about the band's voxels that touch the surface), then
-/// a sweep over the voxels; colour and smooth count from coloring.hpp.
-void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, const ProgressCallback& progress,
-                       BakeStats& stats, openvdb::GridPtrVec& grids) {
+/// The attribute grids ("color", "trap", "iterations") on attributeVoxels(), within `kept` if
+/// given (a tile's), each an extension field: every voxel holds the value at the surface point
+/// nearest to it (OpenVDB's fast sweeping, along the distance's gradient), so the inside shows,
+/// through the depth light reaches, the colour its surface has, as the mesh's vertices and the
+/// preview do; a voxel's own orbit would give the inside's colour instead (bounded orbits: the
+/// palette's far end). One fractal evaluation a surface crossing (about the band's voxels that
+/// touch the surface), then a sweep over the voxels; colour and smooth count from coloring.hpp.
+void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, const openvdb::CoordBBox* kept,
+                       const ProgressCallback& progress, BakeStats& stats, openvdb::GridPtrVec& grids) {
     const bool color = hasGrid(params.bake, BakeGrid::Color);
     const bool trap = hasGrid(params.bake, BakeGrid::Trap);
     const bool iterations = hasGrid(params.bake, BakeGrid::Iterations);
     if (!color && !trap && !iterations) return;
     if (progress && !progress(0.0)) throw Cancelled();
     // The level set's distances over the attribute voxels (its band stops short of their depth).
+    // A tile sweeps over all it baked, its halo included, and keeps its box.
     openvdb::MaskGrid voxels(std::make_shared<openvdb::MaskTree>(attributeVoxels(surface, params.bake)));
     voxels.setTransform(surface.transform().copy());
     const openvdb::FloatGrid::Ptr distance = openvdb::tools::maskSdf(surface, voxels);
@@ -134,6 +126,7 @@ void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, 
         return evaluate(params.fractal, slice.map(p * h));
     };
     auto name = [&](auto grid, const char* label) {
+        if (kept) grid->tree().clip(*kept);
         grid->setTransform(surface.transform().copy());
         grid->setName(label);
         grid->setGridClass(openvdb::GRID_UNKNOWN);
@@ -162,6 +155,15 @@ void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, 
 }
 
 }  // namespace
+
+openvdb::FloatGrid::Ptr densityFromSurface(const openvdb::FloatGrid& surface) {
+    // Interior 1, a ramp to 0 across the inner half of the band, outside 0 (inactive).
+    openvdb::FloatGrid::Ptr density = surface.deepCopy();
+    openvdb::tools::sdfToFogVolume(*density);
+    density->setName("density");
+    density->setCreator("dqjulia");
+    return density;
+}
 
 void initializeOpenVdb() {
     static std::once_flag once;
@@ -296,37 +298,39 @@ BakeStats bakeVdb(const Params& params, const std::string& path, const BakeOptio
     validate(params);
     if (AtomicFile::lowercaseExtension(path) != ".vdb")
         throw ParamError("output.path", "'" + path + "' must end in .vdb");
+    if (options.tile) checkTile(params, *options.tile);
     AtomicFile file(path, options.existing);  // fails now, before the work, if the folder is not writable
     StagedProgress staged(progress, options.monitor);
     BakeStats stats;
     openvdb::FloatGrid::Ptr surface =
         bakeLevelSet(params, options, bakeMemoryModel(params.bake), staged, stats, 0.7, 0.85);
+    // A tile keeps what it owns; its file holds the surface (the merge needs it) and the
+    // attribute grids, and the merge makes the density from the merged surface.
+    std::optional<openvdb::CoordBBox> kept;
+    if (options.tile) {
+        const openvdb::CoordBBox full = bakeIndexBox(params);
+        kept = keptBox(full, ownedBox(full, *options.tile));
+    }
 
     openvdb::GridPtrVec grids;
-    if (hasGrid(params.bake, BakeGrid::Surface)) grids.push_back(surface);
-    if (hasGrid(params.bake, BakeGrid::Density)) {
-        // Interior 1, a ramp to 0 across the inner half of the band, outside 0 (inactive).
-        openvdb::FloatGrid::Ptr density = surface->deepCopy();
-        openvdb::tools::sdfToFogVolume(*density);
-        density->setName("density");
-        density->setCreator("dqjulia");
-        grids.push_back(density);
+    if (hasGrid(params.bake, BakeGrid::Surface) || kept) grids.push_back(surface);
+    if (hasGrid(params.bake, BakeGrid::Density) && !kept) grids.push_back(densityFromSurface(*surface));
+    addAttributeGrids(params, *surface, kept ? &*kept : nullptr, staged.stage(BakeStage::Grids, 0.85, 0.95), stats,
+                      grids);
+    if (kept) {
+        surface->tree().clip(*kept);
+        stats.activeVoxels = surface->activeVoxelCount();
     }
-    addAttributeGrids(params, *surface, staged.stage(BakeStage::Grids, 0.85, 0.95), stats, grids);
 
     staged.stage(BakeStage::Writing, 0.95, 1.0);
     if (progress && !progress(0.95)) throw Cancelled();
     openvdb::MetaMap metadata;
     metadata.insertMeta("creator", openvdb::StringMetadata(std::string("dqjulia ") + DQJ_VERSION_STRING));
-    metadata.insertMeta("dqjulia_parameters", openvdb::StringMetadata(toJson(params)));
+    const std::string document = toJson(params);
+    metadata.insertMeta("dqjulia_parameters", openvdb::StringMetadata(document));
     metadata.insertMeta("dqjulia_voxel_size", openvdb::DoubleMetadata(stats.voxelSize));
-    try {
-        CheckedVdbWriter().writeTo(file.stream(), grids, metadata);
-    } catch (const openvdb::Exception& error) {
-        if (!file.stream()) file.commit();  // throws with the write's reason ("No space left on device")
-        throw std::runtime_error(AtomicFile::failureMessage(path, error.what()));
-    }
-    file.commit();
+    if (options.tile) addTileMetadata(metadata, params, *options.tile, document);
+    writeVdbFile(file, grids, metadata);
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (progress) progress(1.0);
     return stats;

@@ -31,4 +31,8 @@ void initializeOpenVdb();
 openvdb::FloatGrid::Ptr bakeLevelSet(const Params& params, const BakeOptions& options, const MemoryModel& memory,
                                      StagedProgress& progress, BakeStats& stats, double sampledAt, double rebuiltAt);
 
+/// The fog volume "density" of a level set: 1 inside, a ramp to 0 across the inner half of the
+/// band, 0 outside (sdfToFogVolume on a copy).
+openvdb::FloatGrid::Ptr densityFromSurface(const openvdb::FloatGrid& surface);
+
 }  // namespace dqj
