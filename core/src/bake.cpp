@@ -21,6 +21,7 @@
 #include <openvdb/tools/LevelSetRebuild.h>
 #include <openvdb/tools/LevelSetUtil.h>
 #include <openvdb/tools/Morphology.h>
+#include <openvdb/tools/Prune.h>
 
 #include "atomic_file.hpp"
 #include "level_set.hpp"
@@ -139,6 +140,8 @@ void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, 
 
     auto assemble = [&](auto& parts, auto grid, const char* name) {
         for (auto& leaf : parts) grid->tree().addLeaf(leaf.release());
+        // Leaves of the mask whose voxels were all switched off (the air beyond the band) hold nothing.
+        openvdb::tools::pruneInactive(grid->tree());
         grid->setTransform(surface.transform().copy());
         grid->setName(name);
         grid->setGridClass(openvdb::GRID_UNKNOWN);

@@ -50,7 +50,9 @@ const char* const kAnimation = R"({
   "animation": {"slice.rotations[0].degrees": [{"frame": 1, "value": 0}, {"frame": 3, "value": 30}]}})";
 
 TEST_F(FarmCli, TilesMergeIntoTheOnePieceBakesFile) {
-    const std::string flags = "-q -r 40 --grids surface,density,color,iterations ";
+    // The colours reach 6 voxels deep, below the band: tiles then bake that much more halo.
+    const std::string params = write("deep.json", R"({"bake": {"color_depth": 0.15}})");
+    const std::string flags = "-q -r 40 -p '" + params + "' --grids surface,density,color,iterations ";
     ASSERT_EQ(run("bake " + flags + "-o " + quoted("whole.vdb")).exitCode, 0);
     const auto tiles = run("bake " + flags + "--tiles 3x2x1 -o " + quoted("tiled.vdb"));
     ASSERT_EQ(tiles.exitCode, 0) << tiles.err;
@@ -67,7 +69,7 @@ TEST_F(FarmCli, TilesMergeIntoTheOnePieceBakesFile) {
     EXPECT_EQ(withoutFileId(path("tiled.vdb")), withoutFileId(path("whole.vdb")));
     // One tile at a time, as a farm's tasks bake them.
     ASSERT_EQ(run("bake " + flags + "--tiles 3x2x1 --tile 4 -o " + quoted("one.vdb")).exitCode, 0);
-    EXPECT_EQ(dqj::test::fileNames(dir_).size(), 1u + 6 + 2 + 1);  // whole, 6 tiles, named, tiled, one's tile
+    EXPECT_EQ(dqj::test::fileNames(dir_).size(), 1u + 1 + 6 + 2 + 1);  // deep.json, whole, 6 tiles, named, tiled, one's
     EXPECT_EQ(withoutFileId(path("one.tile_4.vdb")), withoutFileId(path("tiled.tile_4.vdb")));
 }
 
