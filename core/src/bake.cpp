@@ -32,8 +32,6 @@
 
 namespace dqj {
 
-using FloatLeaf = openvdb::FloatTree::LeafNodeType;
-using ColorLeaf = openvdb::Vec3STree::LeafNodeType;
 
 namespace {
 
