@@ -4,7 +4,8 @@
 // refuses tiles that do not belong together or do not cover the box once.
 #include <gtest/gtest.h>
 
-#include <cstring>
+#include <bit>
+#include <cstdint>
 #include <iostream>
 #include <filesystem>
 #include <map>
@@ -69,6 +70,12 @@ struct Comparison {
     std::uint64_t active = 0;
 };
 
+/// Bit for bit, so that -0 and 0 (or two NaNs) are told apart.
+bool sameBits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b); }
+bool sameBits(const openvdb::Vec3s& a, const openvdb::Vec3s& b) {
+    return sameBits(a.x(), b.x()) && sameBits(a.y(), b.y()) && sameBits(a.z(), b.z());
+}
+
 template <typename GridT>
 Comparison compareGrids(const GridT& a, const GridT& b) {
     openvdb::CoordBBox box = a.evalActiveVoxelBoundingBox();
@@ -82,7 +89,7 @@ Comparison compareGrids(const GridT& a, const GridT& b) {
         const bool on = x.isValueOn(*ijk);
         ++result.voxels;
         result.active += on;
-        if (on != y.isValueOn(*ijk) || std::memcmp(&u, &v, sizeof u) != 0) {
+        if (on != y.isValueOn(*ijk) || !sameBits(u, v)) {
             ++result.differences;
         }
     }
