@@ -265,6 +265,7 @@ MergeStats mergeTiles(const std::vector<std::string>& tiles, const std::string& 
     initializeOpenVdb();
     // First every tile's metadata: nothing heavy is read before the tiles are known to fit.
     std::vector<TileHeader> headers;
+    headers.reserve(tiles.size());
     for (const std::string& tile : tiles) headers.push_back(readTileHeader(tile));
     checkTilesBelongTogether(headers);
     std::sort(headers.begin(), headers.end(),

@@ -4,8 +4,10 @@
 // refuses tiles that do not belong together or do not cover the box once.
 #include <gtest/gtest.h>
 
-#include <cstring>
-#include <iostream>
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <cmath>
 #include <filesystem>
 #include <map>
 
@@ -75,6 +77,11 @@ struct Comparison {
 
 double distance(float u, float v) { return std::abs(double(u) - double(v)); }
 double distance(const openvdb::Vec3s& u, const openvdb::Vec3s& v) { return double((u - v).length()); }
+/// Bit for bit, so that -0 and 0 (or two NaNs) are told apart.
+bool sameBits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b); }
+bool sameBits(const openvdb::Vec3s& a, const openvdb::Vec3s& b) {
+    return sameBits(a.x(), b.x()) && sameBits(a.y(), b.y()) && sameBits(a.z(), b.z());
+}
 
 template <typename GridT>
 Comparison compareGrids(const GridT& a, const GridT& b) {
@@ -89,7 +96,7 @@ Comparison compareGrids(const GridT& a, const GridT& b) {
         const bool on = x.isValueOn(*ijk);
         ++result.voxels;
         result.active += on;
-        if (on != y.isValueOn(*ijk) || std::memcmp(&u, &v, sizeof u) != 0) {
+        if (on != y.isValueOn(*ijk) || !sameBits(u, v)) {
             ++result.differences;
             if (on != y.isValueOn(*ijk))
                 ++result.stateDiffers;
