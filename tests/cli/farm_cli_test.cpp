@@ -51,7 +51,7 @@ const char* const kAnimation = R"({
 
 TEST_F(FarmCli, TilesMergeIntoTheOnePieceBakesFile) {
     // The surface and density merge exactly, so the file is the one-piece bake's byte for byte;
-    // the attribute grids (fast-swept extension fields) within a tolerance (tests/core/tiles_test).
+    // the attribute grids (fast-swept extension fields) to float rounding (tests/core/tiles_test).
     const std::string flags = "-q -r 40 --grids surface,density ";
     ASSERT_EQ(run("bake " + flags + "-o " + quoted("whole.vdb")).exitCode, 0);
     const auto tiles = run("bake " + flags + "--tiles 3x2x1 -o " + quoted("tiled.vdb"));
