@@ -95,13 +95,4 @@ class DQJULIA_OT_farm_bake(bpy.types.Operator):
 
 
 CLASSES = (DQJULIA_OT_farm_bake,)
-
-
-def register():
-    for cls in CLASSES:
-        bpy.utils.register_class(cls)
-
-
-def unregister():
-    for cls in reversed(CLASSES):
-        bpy.utils.unregister_class(cls)
+register, unregister = bpy.utils.register_classes_factory(CLASSES)
