@@ -255,7 +255,9 @@ nlohmann::ordered_json openJdStep(const std::string& name, const FarmPlan& plan,
         parameters.push_back({{"name", "Frames"}, {"type", "STRING"}, {"range", plan.chunkRanges()}});
     }
     if (plan.tiling && !merge) {
-        for (const char* arg : {"--tiles", tilingText(*plan.tiling).c_str(), "--tile", "{{Task.Param.Tile}}"})
+        const std::string tiling = tilingText(*plan.tiling);  // outlives the loop (a temporary's c_str() did not)
+        for (const std::string& arg :
+             {std::string("--tiles"), tiling, std::string("--tile"), std::string("{{Task.Param.Tile}}")})
             args.push_back(arg);
         parameters.push_back({{"name", "Tile"}, {"type", "INT"}, {"range", "1-" + std::to_string(plan.tiles())}});
     }
