@@ -13,6 +13,7 @@ packages=(
   xvfb xauth glslang-tools  # the add-on's preview in a real Blender window (xvfb-run); its GLSL checked
   povray  # tests/povray evaluate dqjulia.inc and render generated scenes in the real POV-Ray 3.7
   clang-format clang-tidy  # scripts/check-style.sh (the test style.check); ruff comes from scripts/ruff-env.sh
+  slurm-wlm munge  # tests/farm: a one-node Slurm cluster on localhost runs a frame array and a tiled bake
   g++-mingw-w64-x86-64-posix wine64  # the Windows build (scripts/build-windows.sh) and its tests under Wine
 )
 packages+=("$@")

@@ -8,6 +8,7 @@ cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 scripts/bpy-env.sh
 scripts/ruff-env.sh
+scripts/openjd-env.sh
 scripts/build.sh
 ctest --test-dir build --output-on-failure -j"$(nproc)"
 

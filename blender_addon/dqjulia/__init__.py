@@ -4,7 +4,8 @@ OpenVDB volumes and meshes, and an OSL volume, all computed by the dqjulia core 
 Layout (one idea a module): native.py (ctypes bindings of the C ABI), props.py (the
 parameters on the object and the parameter file's JSON), slicing.py (the slice's 8-D axes),
 animation.py (keyframes), preview.py (the GLSL preview), jobs.py (work in a thread),
-bakes.py (cache folder, objects from bakes), operators.py, panels.py, osl.py, shaders/.
+bakes.py (cache folder, objects from bakes), operators.py, farm.py (farm tasks' bakes), panels.py,
+osl.py, shaders/.
 """
 
 bl_info = {
@@ -21,7 +22,7 @@ bl_info = {
 import bpy
 from bpy.props import StringProperty
 
-from . import bakes, jobs, native, operators, osl, panels, preview, props
+from . import bakes, farm, jobs, native, operators, osl, panels, preview, props
 
 
 class DQJuliaPreferences(bpy.types.AddonPreferences):
@@ -67,6 +68,7 @@ def register():
     bpy.utils.register_class(DQJuliaPreferences)
     props.register()
     operators.register()
+    farm.register()
     panels.register()
     osl.register()
     preview.register()
@@ -81,6 +83,7 @@ def unregister():
     preview.unregister()
     osl.unregister()
     panels.unregister()
+    farm.unregister()
     operators.unregister()
     props.unregister()
     bpy.utils.unregister_class(DQJuliaPreferences)

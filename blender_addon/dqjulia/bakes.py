@@ -200,19 +200,38 @@ def volume_density(source):
     return VISIBLE_OPTICAL_DEPTH / max(1e-6, s.bake_color_depth * side)
 
 
-def volume_material(name, grid_names, density=10.0):
+def volume_material(name, grid_names, density=10.0, colour=(0.5, 0.5, 0.5), ambient=0.15):
+    """A Principled Volume: the "density" grid times `density`, coloured by the "color" grid when
+    there is one (else the flat `colour`), which is also its scattering albedo. A dense volume
+    lit by one light scatters about a sixth of what a surface of its colour reflects, so it also
+    glows with `ambient` times its colour where it is dense (the emission is per unit of density:
+    a thick part shows ambient * colour), as the preview's and the renderer's ambient term does."""
     material, volume = principled_volume_material(name)
     tree = material.node_tree
     volume.inputs["Density"].default_value = density
     if "Density Attribute" in volume.inputs:
         volume.inputs["Density Attribute"].default_value = "density"
     if "color" in grid_names:
-        if "Color Attribute" in volume.inputs:
-            volume.inputs["Color Attribute"].default_value = "color"
+        # Through the Color input only: the node's "Color Attribute" would multiply it again
+        # (it did: the colours came out squared, a murky brown).
         attribute = tree.nodes.new("ShaderNodeAttribute")
         attribute.attribute_name = "color"
-        attribute.location = (-250, 100)
+        attribute.location = (-300, 150)
         tree.links.new(attribute.outputs["Color"], volume.inputs["Color"])
+        tree.links.new(attribute.outputs["Color"], volume.inputs["Emission Color"])
+    else:
+        volume.inputs["Color"].default_value = list(colour) + [1.0]
+        volume.inputs["Emission Color"].default_value = list(colour) + [1.0]
+    fog = tree.nodes.new("ShaderNodeAttribute")
+    fog.attribute_name = "density"
+    fog.location = (-500, -150)
+    glow = tree.nodes.new("ShaderNodeMath")
+    glow.operation = "MULTIPLY"
+    glow.label = "Ambient glow"
+    glow.inputs[1].default_value = ambient * density
+    glow.location = (-300, -150)
+    tree.links.new(fog.outputs["Fac"], glow.inputs[0])
+    tree.links.new(glow.outputs["Value"], volume.inputs["Emission Strength"])
     return material
 
 
@@ -250,7 +269,8 @@ def build_volume(context, source, path, sequence=None):
             volume.frame_duration = count
             volume.frame_offset = first - 1
             volume.sequence_mode = "CLIP"
-        material = volume_material(name, names, volume_density(source))
+        s = source.dqjulia
+        material = volume_material(name, names, volume_density(source), tuple(s.color), s.ambient)
         volume.materials.append(material)
         files = [sequence[2]] if sequence else [path]
         return _replace(context, source, kind, name, volume, files)

@@ -484,6 +484,24 @@ def estimate_sequence(document, frames, folder):
     return extrapolate(s1, s2) * len(frames), extrapolate(t1, t2) * len(frames)
 
 
+def sequence_tasks(obj, scene, frames, directory):
+    """The volume bakes of `frames` as Blender evaluates them (keyframes, drivers), each checked
+    by the core, into `directory`/NAME_0001.vdb, ... (Bake Sequence's, and farm.py's)."""
+    documents = animation.frame_documents(obj, scene, frames)
+    for frame, document in zip(frames, documents):
+        if "density" not in document["bake"]["grids"]:
+            document["bake"]["grids"].append("density")
+        try:
+            with native.Context() as context:
+                context.set_params(document)
+        except native.NativeError as error:
+            raise ValueError("frame %d: %s" % (frame, error.message)) from None
+    return [
+        jobs.VolumeTask(document, bakes.sequence_frame_path(directory, obj, frame), frame=frame)
+        for frame, document in zip(frames, documents)
+    ]
+
+
 class DQJULIA_OT_bake_sequence(_BakeOperator, bpy.types.Operator):
     """Bake a volume for every frame of the scene's frame range (the keyframed values of each frame) and add a Volume object that plays them back"""
 
@@ -526,23 +544,11 @@ class DQJULIA_OT_bake_sequence(_BakeOperator, bpy.types.Operator):
         frames = list(range(scene.frame_start, scene.frame_end + 1))
         if not frames:
             raise ValueError("the scene's frame range is empty")
-        documents = animation.frame_documents(obj, scene, frames)
-        for frame, document in zip(frames, documents):
-            if "density" not in document["bake"]["grids"]:
-                document["bake"]["grids"].append("density")
-            try:
-                self._check_document(document)
-            except native.NativeError as error:
-                raise ValueError("frame %d: %s" % (frame, error.message))
         directory = bakes.new_sequence_dir(obj, context)
         self._cleanup = (directory,)
         self._frames = frames
         self._directory = directory
-        tasks = [
-            jobs.VolumeTask(document, bakes.sequence_frame_path(directory, obj, frame), frame=frame)
-            for frame, document in zip(frames, documents)
-        ]
-        return jobs.Job("Bake sequence", tasks, owner=obj.name)
+        return jobs.Job("Bake sequence", sequence_tasks(obj, scene, frames, directory), owner=obj.name)
 
     def build(self, context, obj, job):
         frames = self._frames

@@ -25,12 +25,37 @@ def _wrapped(layout, text, icon="NONE", alert=False, width=None):
         column.label(text=line, icon=icon if index == 0 else "BLANK1")
 
 
-def _quaternion_row(layout, settings, name, label):
-    """One labelled row of a quaternion's four components: "a  s [ ] i [ ] j [ ] k [ ]"."""
-    row = layout.row(align=True)
-    row.label(text=label)
-    for index, component in enumerate("sijk"):
-        row.prop(settings, name, index=index, text=component)
+QUATERNION_LABEL_FACTOR = 0.1  # the row label's share of the width: one letter
+QUATERNION_FIELD_WIDTH = 64  # pixels (at UI scale 1) a field needs to show "-0.391"
+
+
+def _constant(layout, context, settings):
+    """The constant's two quaternions a and b under the heads s, i, j, k: as two rows when four
+    fields fit across the region, else (the sidebar's default width) as two columns of four
+    labelled fields, since a row of four there showed no more than "-0."."""
+    region = context.region
+    scale = context.preferences.system.ui_scale
+    across = (region.width if region else 400) * (1.0 - QUATERNION_LABEL_FACTOR) - 30 * scale
+    if across >= 4 * QUATERNION_FIELD_WIDTH * scale:
+        column = layout.column(align=True)
+        split = column.split(factor=QUATERNION_LABEL_FACTOR)
+        split.label(text="")
+        heads = split.row(align=True)
+        for component in "sijk":
+            heads.label(text=component)
+        for name, label in (("c_a", "a"), ("c_b", "b")):
+            split = column.split(factor=QUATERNION_LABEL_FACTOR)
+            split.label(text=label)
+            row = split.row(align=True)
+            for index in range(4):
+                row.prop(settings, name, index=index, text="")
+        return
+    row = layout.row()
+    for name, label in (("c_a", "a"), ("c_b", "b")):
+        column = row.column(align=True)
+        column.label(text=label)
+        for index, component in enumerate("sijk"):
+            column.prop(settings, name, index=index, text=component)
 
 
 class DQJULIA_MT_presets(bpy.types.Menu):
@@ -100,9 +125,7 @@ class _MainPanel:
         column.prop(s, "iterations")
         column.prop(s, "bailout")
         column.label(text="Constant c = a + b\u03b5:")
-        constant = column.column(align=True)
-        _quaternion_row(constant, s, "c_a", "a")
-        _quaternion_row(constant, s, "c_b", "b")
+        _constant(column, context, s)
 
         state = preview.state_for(obj)
         if state.error:

@@ -157,7 +157,7 @@ def _quaternion_halves(key):
             name="%s %s" % (field["label"], suffix),
             size=4,
             default=tuple(values),
-            precision=5,
+            precision=3,  # four to a row fit the sidebar's default width (the value keeps every digit)
             step=1,
             description="%s: %s part (s, i, j, k)" % (field["help"], part),
             update=_redraw,

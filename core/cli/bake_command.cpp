@@ -1,5 +1,7 @@
 // dqjulia bake: the fractal as an OpenVDB file (level set "surface", fog volume "density",
-// attribute grids), one file or, with --frames, one file per frame of an animation.
+// attribute grids), one file or, with --frames, one file per frame of an animation; with
+// --tiles, tiles of it for dqjulia merge.
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 
@@ -8,28 +10,53 @@
 #include "common.hpp"
 #include "dqjulia/bake.hpp"
 #include "dqjulia/inspect.hpp"
+#include "dqjulia/threads.hpp"
+#include "dqjulia/tiles.hpp"
+#include "file_names.hpp"
 
 namespace dqj::cli {
 namespace {
 
-/// The work of one file: which frame, its parameters and where it goes.
+/// The work of one file: which frame (and tile), its parameters and where it goes.
 struct Job {
     int frame = 1;
+    std::optional<Tile> tile;
     Params params;
     std::string path;
+    std::string label;  // "frame 3", "tile 2", "frame 3, tile 2" or ""
 };
 
-/// Every frame's parameters and output path, checked before the first long bake starts.
+/// Every file's parameters and output path, checked before the first long bake starts; with
+/// --skip-existing, the files that exist are left out (and reported).
 std::vector<Job> plan(const BakeFlags& flags, const Params& params) {
+    const std::optional<Tile> tiling = flags.tiling();
     std::vector<Job> jobs;
-    if (const auto range = flags.frameRange()) {
-        for (int frame = range->first; frame <= range->last; ++frame)
-            jobs.push_back({frame, paramsAtFrame(params, frame), framePath(flags.output, frame)});
-    } else {
-        jobs.push_back({1, paramsAtFrame(params, 1), flags.output});
+    for (const auto& [frame, path] : framePaths(flags)) {
+        const Params atFrame = paramsAtFrame(params, frame);
+        const std::string frameLabel = flags.frameRange() ? "frame " + std::to_string(frame) : "";
+        if (!tiling) {
+            jobs.push_back({frame, std::nullopt, atFrame, path, frameLabel});
+            continue;
+        }
+        Tile tile = *tiling;
+        const int first = tile.index ? tile.index : 1, last = tile.index ? tile.index : tileCount(tile);
+        for (tile.index = first; tile.index <= last; ++tile.index) {
+            const std::string tileLabel = "tile " + std::to_string(tile.index);
+            checkTile(atFrame, tile);
+            jobs.push_back({frame, tile, atFrame, tilePath(path, tile.index),
+                            frameLabel.empty() ? tileLabel : frameLabel + ", " + tileLabel});
+        }
     }
-    for (const Job& job : jobs) checkOutputPath(job.path, flags.force);
-    return jobs;
+    std::vector<Job> todo;
+    for (Job& job : jobs) {
+        if (flags.skipExisting && std::filesystem::is_regular_file(pathFromUtf8(job.path))) {
+            if (!flags.quiet) std::cerr << "skipped " << job.path << ": it exists (--skip-existing)\n";
+            continue;
+        }
+        checkOutputPath(job.path, flags.force);
+        todo.push_back(std::move(job));
+    }
+    return todo;
 }
 
 int runBake(const BakeFlags& flags) {
@@ -38,7 +65,9 @@ int runBake(const BakeFlags& flags) {
     for (char& ch : extension) ch = char(std::tolower(static_cast<unsigned char>(ch)));
     if (extension != ".vdb") throw ParamError("output.path", "--output '" + flags.output + "' must end in .vdb");
     const std::uint64_t memoryLimit = flags.memoryLimit();
+    flags.checkExistingFlags();
     const std::vector<Job> jobs = plan(flags, params);
+    const ThreadLimit threads(flags.threadCount());
 
     for (std::size_t index = 0; index < jobs.size(); ++index) {
         const Job& job = jobs[index];
@@ -48,7 +77,8 @@ int runBake(const BakeFlags& flags) {
         options.memoryLimit = memoryLimit;
         options.monitor = &monitor;
         options.existing = existingPolicy(flags.force);
-        const std::string label = jobs.size() > 1 ? "baking frame " + std::to_string(job.frame) : "baking";
+        options.tile = job.tile;
+        const std::string label = jobs.size() > 1 ? "baking " + job.label : "baking";
         BakeStats stats;
         {
             ProgressBar bar(label, flags.quiet);
@@ -57,13 +87,13 @@ int runBake(const BakeFlags& flags) {
             } catch (const Cancelled&) {
                 bar.finish();
                 if (index == 0) throw;
-                std::cerr << "dqjulia bake: interrupted at frame " << job.frame << "; frames " << jobs.front().frame
-                          << " to " << jobs[index - 1].frame << " were written, frame " << job.frame << " was not\n";
+                std::cerr << "dqjulia bake: interrupted at " << job.label << "; " << jobs.front().label << " to "
+                          << jobs[index - 1].label << " were written, " << job.label << " was not\n";
                 return kInterrupted;
             }
             bar.finish();
         }
-        if (stats.activeVoxels == 0) {
+        if (stats.activeVoxels == 0 && !job.tile) {  // a tile may lie where the surface is not
             const std::string reason = inspect(job.params).emptyReason;
             std::cerr << "dqjulia bake: warning: " << job.path << " holds no surface: "
                       << (reason.empty()
@@ -79,7 +109,7 @@ int runBake(const BakeFlags& flags) {
                       << " s)\n"
                       << std::defaultfloat;
         if (flags.stats) {
-            if (jobs.size() > 1) std::cout << "frame " << job.frame << "\n";
+            if (jobs.size() > 1) std::cout << job.label << "\n";
             printBakeStats(stats);
         }
     }
@@ -93,7 +123,7 @@ Runner addBakeCommand(CLI::App& app) {
     CLI::App* command = app.add_subcommand(
         "bake",
         "Bake an OpenVDB file: level set \"surface\", fog volume \"density\" and attribute grids (README: Baking)");
-    flags->addTo(*command, false);
+    flags->addTo(*command, BakeCommand::Bake);
     return [flags] { return reportErrors("bake", [&] { return runBake(*flags); }); };
 }
 

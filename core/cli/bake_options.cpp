@@ -8,6 +8,8 @@
 #include <sys/resource.h>
 #endif
 
+#include "dqjulia/threads.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -50,10 +52,21 @@ int parseFrame(const std::string& text, const std::string& whole) {
 
 }  // namespace
 
-void BakeFlags::addTo(CLI::App& command, bool mesh) {
+const char* const kExitCodesHelp =
+    "Exit status: 0 done (also when --skip-existing found everything done); 1 failed while working (I/O, "
+    "memory ran out, an output appeared meanwhile): a retry may help, and with --skip-existing redoes only what "
+    "is missing; 2 bad input (flags, parameters, tiles that do not belong together, an existing output): a "
+    "retry cannot help until the input changes; 130 interrupted (Ctrl-C, SIGTERM, SIGHUP: a preempted task): "
+    "a retry helps.";
+
+void BakeFlags::addTo(CLI::App& command, BakeCommand kind) {
+    const bool mesh = kind == BakeCommand::Mesh;
     fractal.addTo(command);
     command
-        .add_option("-o,--output", output, mesh ? "Output mesh: .ply (binary) or .obj" : "Output OpenVDB file (.vdb)")
+        .add_option("-o,--output", output,
+                    mesh                        ? "Output mesh: .ply (binary) or .obj"
+                    : kind == BakeCommand::Farm ? "The bake's output file (.vdb), on storage every machine shares"
+                                                : "Output OpenVDB file (.vdb)")
         ->required();
     command
         .add_option("-r,--resolution", resolution,
@@ -80,13 +93,68 @@ void BakeFlags::addTo(CLI::App& command, bool mesh) {
     }
     command.add_option("--frames", frames,
                        "Keyframed parameters: bake frames FIRST-LAST into NAME_0001.EXT, ... (or one frame)");
+    if (kind != BakeCommand::Mesh)
+        command.add_option("--tiles", tiles,
+                           "Bake in AxBxC tiles on the whole bake's grid, into NAME.tile_K.vdb (K from 1, x fastest); "
+                           "dqjulia merge joins them (README: Baking on a farm)");
+    if (kind == BakeCommand::Farm) {
+        command.add_flag("-f,--force", force, "Overwrite the script files");
+        return;
+    }
+    if (kind == BakeCommand::Bake)
+        command.add_option("--tile", tile, "With --tiles: bake tile K alone (default: every tile, one after another)");
     command.add_option("--max-memory", maxMemory,
                        "Refuse when the estimate exceeds this, e.g. 4G or 512M (default: half the available memory)");
+    command
+        .add_option("--threads", threads,
+                    "Threads to use (default: SLURM_CPUS_PER_TASK, else the CPUs this process may run on)")
+        ->check(CLI::Range(1, 4096));
+    command.add_flag("--skip-existing", skipExisting,
+                     "Skip the frames (and tiles) whose output file exists: they are complete, since files get their "
+                     "name only when complete");
     command.add_flag("--dense", dense, "Evaluate every voxel instead of skipping empty blocks (slow; for comparisons)");
     command.add_flag("-f,--force", force, "Overwrite existing output files");
     command.add_flag("-q,--quiet", quiet, "No progress bar or summary");
     command.add_flag("--stats", stats,
                      "Print time, voxels evaluated against dense, active voxels and peak memory to stdout");
+    command.footer(kExitCodesHelp);
+}
+
+std::optional<Tile> BakeFlags::tiling() const {
+    if (tiles.empty()) {
+        if (tile) throw ParamError("tiles", "--tile goes with --tiles AxBxC: give the tiling too");
+        return std::nullopt;
+    }
+    Tile result;
+    try {
+        result = parseTiling(tiles);
+    } catch (const ParamError& error) {
+        throw ParamError(error.key(), std::string("--") + error.what());
+    }
+    result.index = tile.value_or(0);
+    if (tile && (*tile < 1 || *tile > tileCount(result)))
+        throw ParamError("tiles", "--tile " + std::to_string(*tile) + ": the tiling " + tilingText(result) +
+                                      " has tiles 1 to " + std::to_string(tileCount(result)));
+    return result;
+}
+
+int BakeFlags::threadCount() const { return threads.value_or(defaultThreadCount()); }
+
+void BakeFlags::checkExistingFlags() const {
+    if (force && skipExisting)
+        throw ParamError("output.path",
+                         "--force replaces existing outputs and --skip-existing keeps them: give one of the two");
+}
+
+std::vector<std::pair<int, std::string>> framePaths(const BakeFlags& flags) {
+    std::vector<std::pair<int, std::string>> result;
+    if (const auto range = flags.frameRange()) {
+        for (int frame = range->first; frame <= range->last; ++frame)
+            result.emplace_back(frame, framePath(flags.output, frame));
+    } else {
+        result.emplace_back(1, flags.output);
+    }
+    return result;
 }
 
 Params BakeFlags::load() const {
@@ -198,8 +266,6 @@ std::string evaluatedSummary(const BakeStats& stats) {
            percent(stats.evaluated, stats.dense) + ")";
 }
 
-namespace {
-
 /// The process's peak resident memory.
 std::uint64_t peakMemoryBytes() {
 #ifdef _WIN32
@@ -211,8 +277,6 @@ std::uint64_t peakMemoryBytes() {
     return std::uint64_t(usage.ru_maxrss) * 1024;
 #endif
 }
-
-}  // namespace
 
 void printBakeStats(const BakeStats& stats) {
     std::cout << "seconds " << stats.seconds << "\n"

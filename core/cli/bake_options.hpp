@@ -12,6 +12,7 @@
 #include "common.hpp"
 #include "dqjulia/bake.hpp"
 #include "dqjulia/params.hpp"
+#include "dqjulia/tiles.hpp"
 
 namespace dqj::cli {
 
@@ -20,6 +21,9 @@ struct FrameRange {
     int first = 1;
     int last = 1;
 };
+
+/// The commands that take the bake flags: each registers the flags that mean something to it.
+enum class BakeCommand { Bake, Mesh, Farm };
 
 struct BakeFlags {
     FractalOptions fractal;
@@ -32,23 +36,41 @@ struct BakeFlags {
     std::string maxMemory;
     std::optional<double> adaptivity;  // mesh only
     bool noColors = false;             // mesh only
+    std::string tiles;                 // bake and farm
+    std::optional<int> tile;           // bake only
+    std::optional<int> threads;        // bake and mesh
+    bool skipExisting = false;         // bake and mesh
     bool dense = false;
     bool force = false;
     bool quiet = false;
     bool stats = false;
 
-    /// Registers the flags; `mesh` adds --adaptivity and --no-colors, else --grids and --band-width.
-    void addTo(CLI::App& command, bool mesh);
+    /// Registers the flags of `command`: mesh adds --adaptivity and --no-colors, bake --grids,
+    /// --band-width and the tiles, farm the parameters' flags and --tiles alone.
+    void addTo(CLI::App& command, BakeCommand kind);
     /// Defaults, the file, then the flags; validated. Throws ParamError.
     Params load() const;
     /// --frames, if given. Throws ParamError for a malformed or reversed range.
     std::optional<FrameRange> frameRange() const;
     /// --max-memory in bytes, or 0 for the default. Throws ParamError.
     std::uint64_t memoryLimit() const;
+    /// --tiles (its index --tile, or 0 for every tile), if given. Throws ParamError.
+    std::optional<Tile> tiling() const;
+    /// --threads, or defaultThreadCount().
+    int threadCount() const;
+    /// What an existing output means: refused (the default), replaced (--force) or skipped
+    /// (--skip-existing). Throws ParamError for both flags at once.
+    void checkExistingFlags() const;
 };
 
 /// "out/fractal.vdb", 12 -> "out/fractal_0012.vdb": the numbering Blender reads as a sequence.
 std::string framePath(const std::string& path, int frame);
+
+/// The frames of --frames, or frame 1 alone; and the output path of each (numbered only with --frames).
+std::vector<std::pair<int, std::string>> framePaths(const BakeFlags& flags);
+
+/// The exit codes as a scheduler reads them, for the commands' --help.
+extern const char* const kExitCodesHelp;
 
 /// The parameters at `frame` (keyframes applied), validated; errors name the frame.
 Params paramsAtFrame(const Params& params, int frame);
@@ -61,5 +83,7 @@ std::string evaluatedSummary(const BakeStats& stats);
 
 /// The lines --stats prints for one bake (stdout), peak memory included.
 void printBakeStats(const BakeStats& stats);
+/// The process's peak resident memory, in bytes (0 where the system does not say).
+std::uint64_t peakMemoryBytes();
 
 }  // namespace dqj::cli

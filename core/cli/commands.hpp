@@ -19,5 +19,7 @@ Runner addPovrayCommand(CLI::App& app);
 Runner addExploreCommand(CLI::App& app);
 Runner addSheetCommand(CLI::App& app);
 Runner addSchemaCommand(CLI::App& app);
+Runner addMergeCommand(CLI::App& app);
+Runner addFarmCommand(CLI::App& app);
 
 }  // namespace dqj::cli

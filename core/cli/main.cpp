@@ -23,8 +23,9 @@ int run(int argc, char** argv) {
     app.set_version_flag("--version", std::string("dqjulia ") + dqj_version_string());
     app.require_subcommand(1);
     std::map<CLI::App*, Runner> runners;
-    for (auto add : {addRenderCommand, addEvalCommand, addInspectCommand, addPovrayCommand, addExploreCommand,
-                     addSheetCommand, addBakeCommand, addMeshCommand, addSchemaCommand}) {
+    for (auto add :
+         {addRenderCommand, addEvalCommand, addInspectCommand, addPovrayCommand, addExploreCommand, addSheetCommand,
+          addBakeCommand, addMeshCommand, addMergeCommand, addFarmCommand, addSchemaCommand}) {
         const std::size_t before = app.get_subcommands({}).size();
         Runner runner = add(app);
         runners[app.get_subcommands({}).at(before)] = std::move(runner);

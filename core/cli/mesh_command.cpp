@@ -1,5 +1,6 @@
 // dqjulia mesh: the baked surface as a PLY or OBJ mesh (normals, vertex colours), one file or,
 // with --frames, one file per frame of an animation.
+#include <filesystem>
 #include <iomanip>
 #include <iostream>
 
@@ -8,6 +9,7 @@
 #include "common.hpp"
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/mesh.hpp"
+#include "dqjulia/threads.hpp"
 
 namespace dqj::cli {
 namespace {
@@ -20,19 +22,21 @@ int runMesh(const BakeFlags& flags) {
         throw ParamError("output.path", "--output '" + flags.output + "' must end in .ply or .obj");
     const std::uint64_t memoryLimit = flags.memoryLimit();
 
+    flags.checkExistingFlags();
     std::vector<int> frames;
-    if (const auto range = flags.frameRange()) {
-        for (int frame = range->first; frame <= range->last; ++frame) frames.push_back(frame);
-    } else {
-        frames.push_back(1);
-    }
     std::vector<Params> perFrame;
     std::vector<std::string> paths;
-    for (int frame : frames) {
+    for (const auto& [frame, path] : framePaths(flags)) {
+        if (flags.skipExisting && std::filesystem::is_regular_file(path)) {
+            if (!flags.quiet) std::cerr << "skipped " << path << ": it exists (--skip-existing)\n";
+            continue;
+        }
+        frames.push_back(frame);
         perFrame.push_back(paramsAtFrame(params, frame));
-        paths.push_back(flags.frameRange() ? framePath(flags.output, frame) : flags.output);
+        paths.push_back(path);
         checkOutputPath(paths.back(), flags.force);
     }
+    const ThreadLimit threads(flags.threadCount());
 
     for (std::size_t index = 0; index < frames.size(); ++index) {
         BakeMonitor monitor;
@@ -88,7 +92,7 @@ int runMesh(const BakeFlags& flags) {
 Runner addMeshCommand(CLI::App& app) {
     auto flags = std::make_shared<BakeFlags>();
     CLI::App* command = app.add_subcommand("mesh", "Mesh the baked surface into a PLY or OBJ file (README: Baking)");
-    flags->addTo(*command, true);
+    flags->addTo(*command, BakeCommand::Mesh);
     return [flags] { return reportErrors("mesh", [&] { return runMesh(*flags); }); };
 }
 

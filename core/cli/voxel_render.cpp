@@ -5,123 +5,22 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <cerrno>
-#include <cstring>
-#include <fstream>
-#include <filesystem>
 #include <limits>
 
 #include <glm/geometric.hpp>
-#include <openvdb/io/Stream.h>
 #include <openvdb/openvdb.h>
 
 #include "dqjulia/coloring.hpp"
-#include "file_names.hpp"
 #include "parallel_progress.hpp"
+#include "vdb_file.hpp"
 
 namespace dqj {
 namespace {
 
 constexpr int kTileRows = 8;
 
-/// Walks the container of a VDB file (header, file metadata, grid descriptors) and checks that
-/// every length and offset in it stays inside the file, without allocating anything. OpenVDB
-/// trusts these numbers: a truncated or damaged file made it allocate gigabytes.
-/// Returns an empty string or what is wrong.
-std::string checkVdbContainer(std::istream& in, std::uint64_t size) {
-    std::uint64_t position = 0;
-    auto read = [&](void* data, std::uint64_t bytes) {
-        if (bytes > size - position) return false;
-        in.read(static_cast<char*>(data), std::streamsize(bytes));
-        position += bytes;
-        return bool(in);
-    };
-    auto skip = [&](std::uint64_t bytes) {
-        if (bytes > size - position) return false;
-        position += bytes;
-        in.seekg(std::streamoff(position));
-        return bool(in);
-    };
-    auto skipString = [&] {
-        std::uint32_t length = 0;
-        return read(&length, 4) && skip(length);
-    };
-    auto skipMetadata = [&] {
-        std::int32_t count = 0;
-        if (!read(&count, 4) || count < 0) return false;
-        for (std::int32_t index = 0; index < count; ++index) {
-            std::uint32_t bytes = 0;
-            if (!skipString() || !skipString() || !read(&bytes, 4) || !skip(bytes)) return false;
-        }
-        return true;
-    };
-    std::int64_t magic = 0;
-    std::uint32_t version = 0, major = 0, minor = 0;
-    char hasOffsets = 0;
-    if (!read(&magic, 8) || magic != openvdb::OPENVDB_MAGIC) return "not an OpenVDB file";
-    if (!read(&version, 4) || version < openvdb::OPENVDB_FILE_VERSION_NODE_MASK_COMPRESSION ||
-        version > openvdb::OPENVDB_FILE_VERSION)
-        return "unsupported OpenVDB file version " + std::to_string(version) + " (dqjulia reads versions " +
-               std::to_string(openvdb::OPENVDB_FILE_VERSION_NODE_MASK_COMPRESSION) + " to " +
-               std::to_string(openvdb::OPENVDB_FILE_VERSION) + ")";
-    if (!read(&major, 4) || !read(&minor, 4) || !read(&hasOffsets, 1) || !skip(36))
-        return "the file is truncated (in its header)";
-    if (!hasOffsets) return "the file was written as a stream without grid offsets";
-    if (!skipMetadata()) return "the file is truncated or damaged (in its metadata)";
-    std::int32_t grids = 0;
-    if (!read(&grids, 4) || grids < 0 || std::uint64_t(grids) > size / 16)
-        return "the file is truncated or damaged (its grid count)";
-    for (std::int32_t index = 0; index < grids; ++index) {
-        std::int64_t gridStart = 0, blockStart = 0, end = 0;
-        if (!skipString() || !skipString() || !skipString() || !read(&gridStart, 8) || !read(&blockStart, 8) ||
-            !read(&end, 8))
-            return "the file is truncated or damaged (grid " + std::to_string(index + 1) + "'s descriptor)";
-        if (gridStart < std::int64_t(position) || blockStart < gridStart || end < blockStart ||
-            std::uint64_t(end) > size)
-            return "the file is truncated (grid " + std::to_string(index + 1) + " of " + std::to_string(grids) +
-                   " ends at byte " + std::to_string(end) + " of a file of " + std::to_string(size) + " bytes)";
-        position = std::uint64_t(end);
-        in.seekg(std::streamoff(position));
-        if (!in) return "the file is truncated";
-    }
-    return "";
-}
-
-/// OpenVDB's messages quote file contents and can be enormous: the first line, shortened.
-std::string shortMessage(const std::string& text) {
-    std::string line = text.substr(0, text.find('\n'));
-    if (line.size() > 200) line = line.substr(0, 197) + "...";
-    return line.empty() ? "the file is damaged" : line;
-}
-
 openvdb::FloatGrid::ConstPtr readDensity(const std::string& path) {
-    openvdb::initialize();
-    auto fail = [&](const std::string& reason) { return std::runtime_error("cannot read '" + path + "': " + reason); };
-    const std::filesystem::path name = pathFromUtf8(path);
-    std::ifstream in(name, std::ios::binary);
-    if (!in) throw fail(std::strerror(errno));
-    std::error_code error;
-    const std::uintmax_t size = std::filesystem::file_size(name, error);  // fails for all but regular files
-    if (error || !std::filesystem::is_regular_file(name, error)) throw fail("not a regular file");
-    const std::string problem = checkVdbContainer(in, std::uint64_t(size));
-    if (!problem.empty()) throw fail(problem);
-    in.clear();
-    in.seekg(0);
-    // Any read past the end now throws at once, instead of OpenVDB going on with garbage.
-    in.exceptions(std::ios::badbit | std::ios::failbit | std::ios::eofbit);
-    openvdb::GridBase::Ptr base;
-    try {
-        openvdb::io::Stream stream(in, /*delayLoad=*/false);
-        for (const openvdb::GridBase::Ptr& grid : *stream.getGrids())
-            if (grid && grid->getName() == "density") base = grid;
-    } catch (const std::ios_base::failure&) {
-        throw fail("the file is truncated or damaged (a grid's data ends early)");
-    } catch (const std::bad_alloc&) {
-        throw fail("the file is damaged (its grids claim more memory than there is)");
-    } catch (const std::exception& error) {
-        throw fail(shortMessage(error.what()));
-    }
-    auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(base);
+    auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(findGrid(readVdbFile(path), "density"));
     if (!grid)
         throw std::runtime_error("'" + path + "' has no float grid named \"density\" (bake it with dqjulia bake)");
     return grid;

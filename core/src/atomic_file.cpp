@@ -46,9 +46,9 @@ std::runtime_error systemError(const std::string& path, int error) { return fail
 /// A Win32 error code's text, in UTF-8.
 std::string windowsMessage(DWORD error) {
     wchar_t* text = nullptr;
-    const DWORD length = ::FormatMessageW(
-        FORMAT_MESSAGE_ALLOCATE_BUFFER | FORMAT_MESSAGE_FROM_SYSTEM | FORMAT_MESSAGE_IGNORE_INSERTS, nullptr, error,
-        0, reinterpret_cast<wchar_t*>(&text), 0, nullptr);
+    const DWORD length =
+        ::FormatMessageW(FORMAT_MESSAGE_ALLOCATE_BUFFER | FORMAT_MESSAGE_FROM_SYSTEM | FORMAT_MESSAGE_IGNORE_INSERTS,
+                         nullptr, error, 0, reinterpret_cast<wchar_t*>(&text), 0, nullptr);
     std::string message = length ? utf8FromPath(std::filesystem::path(std::wstring(text, length)))
                                  : "Windows error " + std::to_string(error);
     if (text) ::LocalFree(text);
@@ -456,6 +456,12 @@ std::string AtomicFile::lowercaseExtension(const std::string& path) {
 
 void checkWritable(const std::string& path, Existing existing) {
     AtomicFile probe(path, existing);  // creates (and on destruction discards) a real temporary file there
+}
+
+void writeTextFile(const std::string& path, const std::string& text, Existing existing) {
+    AtomicFile file(path, existing);
+    file.stream() << text;
+    file.commit();
 }
 
 }  // namespace dqj

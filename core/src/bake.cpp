@@ -22,7 +22,8 @@
 #include <unistd.h>
 #endif
 
-#include <openvdb/io/File.h>
+#include <openvdb/tools/FastSweeping.h>
+#include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/LevelSetRebuild.h>
 #include <openvdb/tools/LevelSetUtil.h>
 #include <openvdb/tools/Morphology.h>
@@ -30,12 +31,11 @@
 #include "atomic_file.hpp"
 #include "level_set.hpp"
 #include "parallel_progress.hpp"
-#include "thread_scratch.hpp"
+#include "tile_geometry.hpp"
+#include "vdb_file.hpp"
 
 namespace dqj {
 
-using FloatLeaf = openvdb::FloatTree::LeafNodeType;
-using ColorLeaf = openvdb::Vec3STree::LeafNodeType;
 
 namespace {
 
@@ -47,16 +47,6 @@ public:
 
 private:
     const std::atomic<bool>& stop_;
-};
-
-/// OpenVDB's file writer, aimed at AtomicFile's checked stream. io::File::write opens its own
-/// std::ofstream and never checks it (a full disk gave a truncated file and no error);
-/// Archive's seekable stream writer is what io::File::write calls, so the bytes are the same.
-class CheckedVdbWriter : public openvdb::io::Archive {
-public:
-    void writeTo(std::ostream& out, const openvdb::GridPtrVec& grids, const openvdb::MetaMap& metadata) const {
-        openvdb::io::Archive::write(out, grids, /*seekable=*/true, metadata);
-    }
 };
 
 /// Memory per sampled 8^3 leaf beyond the sampled leaf itself: the rebuild's mesh and distance
@@ -100,70 +90,82 @@ openvdb::MaskTree attributeVoxels(const openvdb::FloatGrid& surface, const BakeS
     return mask;
 }
 
-/// The attribute grids ("color", "trap", "iterations") on attributeVoxels(): one fractal
-/// evaluation a voxel; colour and smooth count from coloring.hpp.
-void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, const ProgressCallback& progress,
-                       BakeStats& stats, openvdb::GridPtrVec& grids) {
+/// The attribute grids ("color", "trap", "iterations") on attributeVoxels(), within `kept` if
+/// given (a tile's), each an extension field: every voxel holds the value at the surface point
+/// nearest to it (OpenVDB's fast sweeping, along the distance's gradient), so the inside shows,
+/// through the depth light reaches, the colour its surface has, as the mesh's vertices and the
+/// preview do; a voxel's own orbit would give the inside's colour instead (bounded orbits: the
+/// palette's far end). One fractal evaluation a surface crossing (about the band's voxels that
+/// touch the surface), then a sweep over the voxels; colour and smooth count from coloring.hpp.
+void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, const openvdb::CoordBBox* kept,
+                       const ProgressCallback& progress, BakeStats& stats, openvdb::GridPtrVec& grids) {
     const bool color = hasGrid(params.bake, BakeGrid::Color);
     const bool trap = hasGrid(params.bake, BakeGrid::Trap);
     const bool iterations = hasGrid(params.bake, BakeGrid::Iterations);
     if (!color && !trap && !iterations) return;
-    const openvdb::MaskTree voxels = attributeVoxels(surface, params.bake);
-    std::vector<const openvdb::MaskTree::LeafNodeType*> leaves;
-    voxels.getNodes(leaves);
-    std::vector<std::unique_ptr<ColorLeaf>> colorLeaves(color ? leaves.size() : 0);
-    std::vector<std::unique_ptr<FloatLeaf>> trapLeaves(trap ? leaves.size() : 0);
-    std::vector<std::unique_ptr<FloatLeaf>> iterationLeaves(iterations ? leaves.size() : 0);
+    if (progress && !progress(0.0)) throw Cancelled();
+    // The level set's distances over the attribute voxels (its band stops short of their depth).
+    // A tile sweeps over all it baked, its halo included, and keeps its box.
+    openvdb::MaskGrid voxels(std::make_shared<openvdb::MaskTree>(attributeVoxels(surface, params.bake)));
+    voxels.setTransform(surface.transform().copy());
+    const openvdb::FloatGrid::Ptr distance = openvdb::tools::maskSdf(surface, voxels);
     const Slice slice = params.slice.effective();
-    const double h = surface.voxelSize()[0];
     std::atomic<std::uint64_t> evaluated{0};
-    ThreadScratch<BatchBuffer<double>> batches;  // a leaf's active voxels through the SIMD kernel together
-    parallelForWithProgress(leaves.size(), progress, [&](std::size_t index, const std::atomic<bool>& stop) {
-        const auto& leaf = *leaves[index];
-        auto colorLeaf = color ? std::make_unique<ColorLeaf>(leaf.origin(), openvdb::Vec3s(0.0f), false) : nullptr;
-        auto trapLeaf = trap ? std::make_unique<FloatLeaf>(leaf.origin(), 0.0f, false) : nullptr;
-        auto iterationLeaf = iterations ? std::make_unique<FloatLeaf>(leaf.origin(), 0.0f, false) : nullptr;
-        if (stop.load(std::memory_order_relaxed)) return;
-        BatchBuffer<double>& batch = batches.local();
-        batch.clear();
-        for (auto voxel = leaf.cbeginValueOn(); voxel; ++voxel) {
-            const openvdb::Coord ijk = voxel.getCoord();
-            batch.add(slice.map(glm::dvec3(ijk.x(), ijk.y(), ijk.z()) * h));
-        }
-        batch.evaluate(params.fractal);
-        std::uint64_t count = 0;
-        for (auto voxel = leaf.cbeginValueOn(); voxel; ++voxel) {
-            const Escape escape = batch.escape(count++);
-            if (colorLeaf) {
-                const glm::dvec3 rgb = orbitColour(params.material, params.fractal, escape);
-                colorLeaf->setValueOn(voxel.pos(), openvdb::Vec3s(float(rgb.x), float(rgb.y), float(rgb.z)));
-            }
-            if (trapLeaf) trapLeaf->setValueOn(voxel.pos(), float(escape.trap));
-            if (iterationLeaf) iterationLeaf->setValueOn(voxel.pos(), float(smoothIterations(params.fractal, escape)));
-        }
-        evaluated += count;
-        if (colorLeaf) colorLeaves[index] = std::move(colorLeaf);
-        if (trapLeaf) trapLeaves[index] = std::move(trapLeaf);
-        if (iterationLeaf) iterationLeaves[index] = std::move(iterationLeaf);
-    });
-    stats.evaluated += evaluated.load();
-
-    auto assemble = [&](auto& parts, auto grid, const char* name) {
-        for (auto& leaf : parts) grid->tree().addLeaf(leaf.release());
+    // OpenVDB 10's sweep passes the functors index coordinates (it takes the transform of the
+    // extension grid it creates, which has none); the bake's grid is index * voxel size. The
+    // orbit is taken kSurfaceColourOffset voxels outside, along the distance's gradient.
+    const double h = surface.voxelSize()[0];
+    auto atSurface = [&](const openvdb::Vec3R& ijk) {
+        ++evaluated;
+        auto at = [&](double x, double y, double z) {
+            return double(openvdb::tools::BoxSampler::sample(surface.tree(), ijk + openvdb::Vec3R(x, y, z)));
+        };
+        glm::dvec3 gradient(at(0.5, 0, 0) - at(-0.5, 0, 0), at(0, 0.5, 0) - at(0, -0.5, 0),
+                            at(0, 0, 0.5) - at(0, 0, -0.5));
+        const double length = glm::length(gradient);
+        if (length > 0.0) gradient /= length;
+        const glm::dvec3 p = glm::dvec3(ijk.x(), ijk.y(), ijk.z()) + kSurfaceColourOffset * gradient;
+        return evaluate(params.fractal, slice.map(p * h));
+    };
+    auto name = [&](auto grid, const char* label) {
+        if (kept) grid->tree().clip(*kept);
         grid->setTransform(surface.transform().copy());
-        grid->setName(name);
+        grid->setName(label);
         grid->setGridClass(openvdb::GRID_UNKNOWN);
         grids.push_back(grid);
         return grid;
     };
-    if (color)
-        assemble(colorLeaves, openvdb::Vec3SGrid::create(openvdb::Vec3s(0.0f)), "color")
+    if (color) {
+        auto rgb = [&](const openvdb::Vec3R& xyz) {
+            const glm::dvec3 c = orbitColour(params.material, params.fractal, atSurface(xyz));
+            return openvdb::Vec3s(float(c.x), float(c.y), float(c.z));
+        };
+        name(openvdb::tools::sdfToExt(*distance, rgb, openvdb::Vec3s(0.0f)), "color")
             ->setVectorType(openvdb::VEC_INVARIANT);
-    if (trap) assemble(trapLeaves, openvdb::FloatGrid::create(0.0f), "trap");
-    if (iterations) assemble(iterationLeaves, openvdb::FloatGrid::create(0.0f), "iterations");
+        if (progress && !progress(0.5)) throw Cancelled();
+    }
+    if (trap) {
+        auto value = [&](const openvdb::Vec3R& xyz) { return float(atSurface(xyz).trap); };
+        name(openvdb::tools::sdfToExt(*distance, value, 0.0f), "trap");
+    }
+    if (iterations) {
+        auto value = [&](const openvdb::Vec3R& xyz) { return float(smoothIterations(params.fractal, atSurface(xyz))); };
+        name(openvdb::tools::sdfToExt(*distance, value, 0.0f), "iterations");
+    }
+    stats.evaluated += evaluated.load();
+    if (progress && !progress(1.0)) throw Cancelled();
 }
 
 }  // namespace
+
+openvdb::FloatGrid::Ptr densityFromSurface(const openvdb::FloatGrid& surface) {
+    // Interior 1, a ramp to 0 across the inner half of the band, outside 0 (inactive).
+    openvdb::FloatGrid::Ptr density = surface.deepCopy();
+    openvdb::tools::sdfToFogVolume(*density);
+    density->setName("density");
+    density->setCreator("dqjulia");
+    return density;
+}
 
 void initializeOpenVdb() {
     static std::once_flag once;
@@ -327,37 +329,39 @@ BakeStats bakeVdb(const Params& params, const std::string& path, const BakeOptio
     validate(params);
     if (AtomicFile::lowercaseExtension(path) != ".vdb")
         throw ParamError("output.path", "'" + path + "' must end in .vdb");
+    if (options.tile) checkTile(params, *options.tile);
     AtomicFile file(path, options.existing);  // fails now, before the work, if the folder is not writable
     StagedProgress staged(progress, options.monitor);
     BakeStats stats;
     openvdb::FloatGrid::Ptr surface =
         bakeLevelSet(params, options, bakeMemoryModel(params.bake), staged, stats, 0.7, 0.85);
+    // A tile keeps what it owns; its file holds the surface (the merge needs it) and the
+    // attribute grids, and the merge makes the density from the merged surface.
+    std::optional<openvdb::CoordBBox> kept;
+    if (options.tile) {
+        const openvdb::CoordBBox full = bakeIndexBox(params);
+        kept = keptBox(full, ownedBox(full, *options.tile));
+    }
 
     openvdb::GridPtrVec grids;
-    if (hasGrid(params.bake, BakeGrid::Surface)) grids.push_back(surface);
-    if (hasGrid(params.bake, BakeGrid::Density)) {
-        // Interior 1, a ramp to 0 across the inner half of the band, outside 0 (inactive).
-        openvdb::FloatGrid::Ptr density = surface->deepCopy();
-        openvdb::tools::sdfToFogVolume(*density);
-        density->setName("density");
-        density->setCreator("dqjulia");
-        grids.push_back(density);
+    if (hasGrid(params.bake, BakeGrid::Surface) || kept) grids.push_back(surface);
+    if (hasGrid(params.bake, BakeGrid::Density) && !kept) grids.push_back(densityFromSurface(*surface));
+    addAttributeGrids(params, *surface, kept ? &*kept : nullptr, staged.stage(BakeStage::Grids, 0.85, 0.95), stats,
+                      grids);
+    if (kept) {
+        surface->tree().clip(*kept);
+        stats.activeVoxels = surface->activeVoxelCount();
     }
-    addAttributeGrids(params, *surface, staged.stage(BakeStage::Grids, 0.85, 0.95), stats, grids);
 
     staged.stage(BakeStage::Writing, 0.95, 1.0);
     if (progress && !progress(0.95)) throw Cancelled();
     openvdb::MetaMap metadata;
     metadata.insertMeta("creator", openvdb::StringMetadata(std::string("dqjulia ") + DQJ_VERSION_STRING));
-    metadata.insertMeta("dqjulia_parameters", openvdb::StringMetadata(toJson(params)));
+    const std::string document = toJson(params);
+    metadata.insertMeta("dqjulia_parameters", openvdb::StringMetadata(document));
     metadata.insertMeta("dqjulia_voxel_size", openvdb::DoubleMetadata(stats.voxelSize));
-    try {
-        CheckedVdbWriter().writeTo(file.stream(), grids, metadata);
-    } catch (const openvdb::Exception& error) {
-        if (!file.stream()) file.commit();  // throws with the write's reason ("No space left on device")
-        throw std::runtime_error(AtomicFile::failureMessage(path, error.what()));
-    }
-    file.commit();
+    if (options.tile) addTileMetadata(metadata, params, *options.tile, document);
+    writeVdbFile(file, grids, metadata);
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (progress) progress(1.0);
     return stats;

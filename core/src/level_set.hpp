@@ -16,6 +16,12 @@
 
 namespace dqj {
 
+/// Bakes take a surface point's colour (and trap, iteration count) this many voxels outside it,
+/// along its normal, where the renderer and the preview take theirs (their hits lie outside the
+/// finite-N set): on the surface itself an orbit is bounded (the inside's colour, the palette's
+/// other end) about as often as not.
+constexpr double kSurfaceColourOffset = 0.5;
+
 /// Registers OpenVDB's grid types once (thread-safe).
 void initializeOpenVdb();
 
@@ -24,5 +30,9 @@ void initializeOpenVdb();
 /// but seconds). Throws MemoryLimitError, Cancelled.
 openvdb::FloatGrid::Ptr bakeLevelSet(const Params& params, const BakeOptions& options, const MemoryModel& memory,
                                      StagedProgress& progress, BakeStats& stats, double sampledAt, double rebuiltAt);
+
+/// The fog volume "density" of a level set: 1 inside, a ramp to 0 across the inner half of the
+/// band, 0 outside (sdfToFogVolume on a copy).
+openvdb::FloatGrid::Ptr densityFromSurface(const openvdb::FloatGrid& surface);
 
 }  // namespace dqj

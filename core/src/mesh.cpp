@@ -211,6 +211,7 @@ Mesh bakeMesh(const Params& params, const BakeOptions& options, const ProgressCa
     // pools become the mesh's arrays, each freed once copied (after the grid), so the mesh is
     // never held twice.
     Mesh mesh;
+    const double voxel = sampled.grid->voxelSize()[0];
     parallelForWithProgress(1, staged.stage(BakeStage::Meshing, 0.8, 0.9), [&](std::size_t, const std::atomic<bool>&) {
         openvdb::tools::VolumeToMesh mesher(0.0, params.bake.adaptivity);
         mesher(*sampled.grid);
@@ -246,7 +247,8 @@ Mesh bakeMesh(const Params& params, const BakeOptions& options, const ProgressCa
     removeDegenerateFaces(mesh);
     mesh.normals = vertexNormals(mesh);
 
-    // Colours: the material's colouring of the orbit at each vertex (orbitColour, coloring.hpp), as the renderer's.
+    // Colours: the material's colouring of the orbit at each vertex (orbitColour, coloring.hpp), as
+    // the renderer's, taken kSurfaceColourOffset voxels outside along the vertex normal.
     if (params.bake.meshColors) {
         mesh.colors.resize(mesh.positions.size());
         const Slice slice = params.slice.effective();
@@ -259,7 +261,8 @@ Mesh bakeMesh(const Params& params, const BakeOptions& options, const ProgressCa
                 BatchBuffer<double>& batch = batches.local();
                 batch.clear();
                 for (std::size_t index = first; index < end; ++index)
-                    batch.add(slice.map(glm::dvec3(mesh.positions[index])));
+                    batch.add(slice.map(glm::dvec3(mesh.positions[index]) +
+                                        kSurfaceColourOffset * voxel * glm::dvec3(mesh.normals[index])));
                 batch.evaluate(params.fractal);
                 for (std::size_t index = first; index < end; ++index)
                     mesh.colors[index] =

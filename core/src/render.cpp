@@ -37,6 +37,18 @@ constexpr int kBisectionSteps = 8;  // refines a step that landed inside to 1/25
 constexpr double kFootprintFloor = 1e-7;
 constexpr int kRaysPerPass = 1024;  // rays traced together: whole pixels of a tile
 
+/// The normal turned towards the eye. A gradient that tips past perpendicular to the ray (a
+/// surface seen edge on, where the differences straddle a crease) is bent back onto the
+/// silhouette, its component along the ray removed, not mirrored: mirroring turned a lit grazing
+/// surface into a dark speckle one pixel wide. A normal pointing straight away becomes -ray.
+glm::dvec3 facingRay(const glm::dvec3& normal, const glm::dvec3& direction) {
+    const double along = glm::dot(normal, direction);
+    if (along <= 0.0) return normal;
+    const glm::dvec3 bent = normal - along * direction;
+    const double length = glm::length(bent);
+    return length > 1e-6 ? bent / length : -direction;
+}
+
 /// Where a ray meets a sphere: [near, far] along the ray, or nothing.
 struct Interval {
     bool valid = false;
@@ -367,7 +379,7 @@ private:
     void finishNormal(const glm::dvec3& gradient) {
         const double length = glm::length(gradient);
         normal_ = length > 0.0 && std::isfinite(length) ? gradient / length : -direction_;
-        if (glm::dot(normal_, direction_) > 0.0) normal_ = -normal_;  // face the camera
+        normal_ = facingRay(normal_, direction_);
         if (scene_->material_.occlusion > 0.0) {
             stage_ = Stage::Occlusion;
         } else {

@@ -17,6 +17,7 @@
 #include "dqjulia/batch.hpp"
 #include "dqjulia/slice.hpp"
 #include "parallel_progress.hpp"
+#include "tile_geometry.hpp"
 
 namespace dqj {
 
@@ -125,13 +126,16 @@ public:
           f_(params, bakeVoxelSize(params)),
           h_(f_.voxelSize()) {
         const Box& box = f_.region().box();
-        constexpr int kPadding = 2;  // voxels beyond the bounds, so the cut face closes
-        for (int axis = 0; axis < 3; ++axis) {
-            lo_[axis] = int(std::floor(box.min[axis] / h_)) - kPadding;
-            hi_[axis] = int(std::ceil(box.max[axis] / h_)) + kPadding;
+        for (int axis = 0; axis < 3; ++axis)
             dense_ *= std::uint64_t(std::max<long long>(1, std::llround((box.max[axis] - box.min[axis]) / h_)));
+        indexBox_ = bakeIndexBox(params);
+        if (options.tile) {
+            // A tile samples the whole bake's grid in its window only; blocks and leaves stay
+            // where the whole bake has them, so every leaf is classified and sampled as there.
+            const double whole = double(indexBox_.volume());
+            indexBox_.intersect(tileWindow(params, *options.tile));
+            dense_ = std::max<std::uint64_t>(1, std::uint64_t(double(dense_) * double(indexBox_.volume()) / whole));
         }
-        indexBox_ = CoordBBox(lo_, hi_);
         // An explicit limit too is capped by what the process may really allocate (ulimit -v,
         // cgroups): beyond that the bake would fail late with an allocation error.
         const std::uint64_t processLimit = processMemoryHeadroom();
@@ -207,9 +211,10 @@ public:
 private:
     std::vector<Coord> allLeaves() const {
         std::vector<Coord> leaves;
-        for (int x = floorTo(lo_.x(), kLeafSize); x <= hi_.x(); x += kLeafSize)
-            for (int y = floorTo(lo_.y(), kLeafSize); y <= hi_.y(); y += kLeafSize)
-                for (int z = floorTo(lo_.z(), kLeafSize); z <= hi_.z(); z += kLeafSize) leaves.emplace_back(x, y, z);
+        const Coord lo = indexBox_.min(), hi = indexBox_.max();
+        for (int x = floorTo(lo.x(), kLeafSize); x <= hi.x(); x += kLeafSize)
+            for (int y = floorTo(lo.y(), kLeafSize); y <= hi.y(); y += kLeafSize)
+                for (int z = floorTo(lo.z(), kLeafSize); z <= hi.z(); z += kLeafSize) leaves.emplace_back(x, y, z);
         return leaves;
     }
 
@@ -224,9 +229,10 @@ private:
     /// leaves next to skipped space) after checking the memory estimate.
     std::vector<Coord> classify(double split) {
         std::vector<Coord> blocks;
-        for (int x = floorTo(lo_.x(), kTopBlockSize); x <= hi_.x(); x += kTopBlockSize)
-            for (int y = floorTo(lo_.y(), kTopBlockSize); y <= hi_.y(); y += kTopBlockSize)
-                for (int z = floorTo(lo_.z(), kTopBlockSize); z <= hi_.z(); z += kTopBlockSize)
+        const Coord lo = indexBox_.min(), hi = indexBox_.max();
+        for (int x = floorTo(lo.x(), kTopBlockSize); x <= hi.x(); x += kTopBlockSize)
+            for (int y = floorTo(lo.y(), kTopBlockSize); y <= hi.y(); y += kTopBlockSize)
+                for (int z = floorTo(lo.z(), kTopBlockSize); z <= hi.z(); z += kTopBlockSize)
                     blocks.emplace_back(x, y, z);
         std::vector<Lists> lists(blocks.size());
         std::atomic<std::uint64_t> surfaceLeaves{0};
@@ -367,8 +373,7 @@ private:
     StagedProgress& progress_;
     SurfaceFunction f_;
     double h_;
-    Coord lo_, hi_;
-    CoordBBox indexBox_;
+    CoordBBox indexBox_;  // the voxels sampled: the whole bake's, or a tile's window of them
     std::uint64_t dense_ = 1;
     std::uint64_t limit_ = 0;
     std::string limitSource_;  // why the limit is what it is, for the message
@@ -450,6 +455,19 @@ void SurfaceFunction::operator()(const glm::dvec3* points, std::size_t count, fl
         const std::size_t i = evaluated[k];
         values[i] = value(batch.n(k), batch.de(k), region_.signedDistance(points[i]));
     }
+}
+
+CoordBBox bakeIndexBox(const Params& params) {
+    const BakeRegion region(params);
+    const Box& box = region.box();
+    const double h = bakeVoxelSize(params);
+    constexpr int kPadding = 2;  // voxels beyond the bounds, so the cut face closes
+    Coord lo, hi;
+    for (int axis = 0; axis < 3; ++axis) {
+        lo[axis] = int(std::floor(box.min[axis] / h)) - kPadding;
+        hi[axis] = int(std::ceil(box.max[axis] / h)) + kPadding;
+    }
+    return CoordBBox(lo, hi);
 }
 
 double bakeVoxelSize(const Params& params) {

@@ -21,6 +21,9 @@ folders the runner (run_blender.cmake) points BLENDER_USER_* at, then runs its c
   bake_volume   Bake Volume: object, grids, material, replacement of an earlier bake
   bake_mesh     Bake Mesh: counts, normals, colours, positions against the core's mesh
   bake_sequence Bake Sequence: 3 frames played back, each its own file
+  farm_bake     farm tasks bake chunks of a saved .blend's sequence into one folder, headless and blocking
+                (Debian's Blender: the real `blender -b scene.blend --python-expr` command); finished frames
+                are skipped; attach adds the sequence and saves the .blend
   cancel        cancelled and failed bakes leave nothing; a threaded bake leaves Python running
   render        Cycles renders the baked volume and the baked mesh: same silhouette (IoU)
   osl           Add OSL Volume: with OSL, its Cycles render matches the baked volume's (IoU);
@@ -36,6 +39,7 @@ import io
 import json
 import os
 import shutil
+import subprocess
 import sys
 import time
 
@@ -73,6 +77,7 @@ CASES = [
     "bake_volume",
     "bake_mesh",
     "bake_sequence",
+    "farm_bake",
     "cancel",
     "render",
     "osl",
@@ -94,9 +99,9 @@ CACHE = os.path.join(ARGS.work, "cache")
 report("Blender %s (%s), case %s" % (bpy.app.version_string, common.blender_kind(), ARGS.case))
 dqjulia = common.install_addon(ARGS.zip, CACHE)
 MODULE = dqjulia.__name__
-animation, bakes, jobs, native, osl, preview, props, slicing = (
+animation, bakes, farm, jobs, native, osl, preview, props, slicing = (
     common.submodule(dqjulia, name)
-    for name in ("animation", "bakes", "jobs", "native", "osl", "preview", "props", "slicing")
+    for name in ("animation", "bakes", "farm", "jobs", "native", "osl", "preview", "props", "slicing")
 )
 
 ADDON_DIR = os.path.dirname(dqjulia.__file__)
@@ -894,6 +899,78 @@ def case_bake_sequence():
     check(
         job.status_text().startswith("Bake sequence: 1 of 2 frames done, 50%") and "left" in job.status_text(),
         "the progress says frames done and time left: %r" % job.status_text(),
+    )
+
+
+def case_farm_bake():
+    folder = os.path.join(ARGS.work, "farm")
+    os.makedirs(folder, exist_ok=True)
+    clear_scene()
+    obj = keyed_object(resolution=32)
+    obj.name = "Julia"
+    scene = bpy.context.scene
+    scene.frame_start, scene.frame_end = 1, 3
+    blend = os.path.join(folder, "scene.blend")
+    bpy.ops.wm.save_as_mainfile(filepath=blend)
+    shared = os.path.join(folder, "shared")
+
+    def frame_file(frame):  # by name: opening the .blend again replaces the objects
+        return os.path.join(shared, "Julia_%04d.vdb" % frame)
+
+    report("== a farm task: frames 1-2 from the saved .blend, headless")
+    expression = "import bpy; bpy.ops.dqjulia.farm_bake(object='Julia', frame_start=1, frame_end=2, directory=%r)"
+    if common.blender_kind() == "blender":
+        command = [bpy.app.binary_path, "-b", blend, "--addons", MODULE, "--python-exit-code", "1"]
+        task = subprocess.run(command + ["--python-expr", expression % shared], capture_output=True, text=True)
+        check(
+            task.returncode == 0 and "Baked 2 of frames 1-2 of Julia" in task.stdout,
+            "blender -b scene.blend --python-expr ... baked frames 1-2 (exit %d)%s"
+            % (task.returncode, "" if task.returncode == 0 else "\n" + task.stdout[-2000:] + task.stderr[-2000:]),
+        )
+        failing = subprocess.run(
+            command + ["--python-expr", "import bpy; bpy.ops.dqjulia.farm_bake(object='Nope')"],
+            capture_output=True,
+            text=True,
+        )
+        check(failing.returncode == 1, "a failing farm task exits 1 (exit %d)" % failing.returncode)
+    else:  # the bpy module has no command line: the task's steps in this process
+        bpy.ops.wm.open_mainfile(filepath=blend)
+        check(bpy.ops.dqjulia.farm_bake(object="Julia", frame_start=1, frame_end=2, directory=shared) == {"FINISHED"},
+              "farm_bake frames 1-2")  # fmt: skip
+    check(os.path.isfile(frame_file(1)) and os.path.isfile(frame_file(2)), "frames 1 and 2 are in the shared folder")
+    first = os.stat(frame_file(2)).st_mtime_ns
+
+    report("== another task, frames 2-3: frame 2 is done already")
+    bpy.ops.wm.open_mainfile(filepath=blend)
+    obj = bpy.data.objects["Julia"]
+    check(bpy.ops.dqjulia.farm_bake(object="Julia", frame_start=2, frame_end=3, directory=shared) == {"FINISHED"},
+          "farm_bake frames 2-3")  # fmt: skip
+    check(os.stat(frame_file(2)).st_mtime_ns == first, "frame 2 was skipped, not baked again")
+    names = sorted(os.listdir(shared))
+    check(names == ["Julia_%04d.vdb" % f for f in (1, 2, 3)], "the folder holds frames 1-3 only: %s" % names)
+    sizes = [os.path.getsize(frame_file(f)) for f in (1, 2, 3)]
+    check(len(set(sizes)) > 1, "the frames differ (keyframes): sizes %s" % sizes)
+    check("density" in bakes.grid_names(frame_file(3)), "a frame holds the density grid")
+    check(baked_child(obj, "sequence") is None, "tasks add nothing to the .blend")
+    result, error = common.call(bpy.ops.dqjulia.farm_bake, object="Nope")
+    check(result == {"CANCELLED"} and "no DQ Julia object 'Nope'" in error, "an unknown object: %r" % error)
+    result, error = common.call(
+        bpy.ops.dqjulia.farm_bake, object="Julia", frame_end=1, directory=os.path.join(folder, "part"), attach=True
+    )
+    check(result == {"CANCELLED"} and "frames [2, 3] are not baked" in error, "attach needs every frame: %r" % error)
+    check(bpy.ops.dqjulia.farm_bake(object="Julia", frame_start=1, frame_end=1) == {"FINISHED"}, "the default folder")
+    check(os.path.isfile(bakes.sequence_frame_path(farm.farm_dir(obj), obj, 1)), "is NAME_farm/ in the cache")
+
+    report("== the last task attaches the sequence and saves the .blend")
+    check(bpy.ops.dqjulia.farm_bake(object="Julia", directory=shared, attach=True) == {"FINISHED"}, "attach")
+    bpy.ops.wm.open_mainfile(filepath=blend)
+    sequence = baked_child(bpy.data.objects["Julia"], "sequence")
+    check(
+        sequence is not None
+        and sequence.data.is_sequence
+        and sequence.data.frame_duration == 3
+        and os.path.dirname(bpy.path.abspath(sequence.data.filepath)) == shared,
+        "the saved .blend plays frames 1-3 from the shared folder",
     )
 
 

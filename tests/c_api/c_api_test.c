@@ -298,8 +298,10 @@ static void test_paths(dqj_context context, const char* scratch_dir) {
     file = open_utf8(path, "wb");
     CHECK(file != NULL, "cannot write %s", path);
     if (!file) return;
-    fputs("{\"fractal\": {\"iterations\": 7}, \"render\": {\"width\": 32, \"height\": 24}, "
-          "\"bake\": {\"resolution\": 16}}", file);
+    fputs(
+        "{\"fractal\": {\"iterations\": 7}, \"render\": {\"width\": 32, \"height\": 24}, "
+        "\"bake\": {\"resolution\": 16}}",
+        file);
     fclose(file);
     CHECK(dqj_context_load_params_file(context, path) == DQJ_OK, "load %s: %s", path, dqj_context_error(context));
     CHECK(dqj_context_get_params_json(context, NULL, 0, &needed) == DQJ_OK, "size query");
@@ -309,7 +311,8 @@ static void test_paths(dqj_context context, const char* scratch_dir) {
     free(json);
     for (pass = 0; pass < 2; ++pass) {
         snprintf(path, sizeof path, "%s%c%s", folder, SEPARATOR, outputs[0]);
-        CHECK(dqj_render_to_file(context, path, NULL, NULL) == DQJ_OK, "render %s: %s", path, dqj_context_error(context));
+        CHECK(dqj_render_to_file(context, path, NULL, NULL) == DQJ_OK, "render %s: %s", path,
+              dqj_context_error(context));
         snprintf(path, sizeof path, "%s%c%s", folder, SEPARATOR, outputs[1]);
         CHECK(dqj_bake_vdb(context, path, NULL, NULL) == DQJ_OK, "bake %s: %s", path, dqj_context_error(context));
         snprintf(path, sizeof path, "%s%c%s", folder, SEPARATOR, outputs[2]);

@@ -61,7 +61,7 @@ def load_on_windows(native_path):
     spec.loader.exec_module(native)
     added, loaded = [], []
     native.sys = types.SimpleNamespace(platform="win32")
-    native.os = types.SimpleNamespace(path=os.path, environ={}, add_dll_directory=lambda folder: added.append(folder))
+    native.os = types.SimpleNamespace(path=os.path, environ={}, add_dll_directory=added.append)
 
     def cdll(path):
         loaded.append(path)
@@ -80,12 +80,12 @@ def main():
     checks = {}
     with zipfile.ZipFile(windows_zip) as windows, zipfile.ZipFile(linux_zip) as linux:
         windows_names, linux_names = set(windows.namelist()), set(linux.namelist())
-        checks["the Windows zip holds dqjulia/lib/dqjulia.dll and no .so"] = "dqjulia/lib/dqjulia.dll" in windows_names and not any(
-            name.endswith(".so") for name in windows_names
-        )
-        checks["the Linux zip holds dqjulia/lib/libdqjulia.so and no .dll"] = "dqjulia/lib/libdqjulia.so" in linux_names and not any(
-            name.endswith(".dll") for name in linux_names
-        )
+        checks["the Windows zip holds dqjulia/lib/dqjulia.dll and no .so"] = "dqjulia/lib/dqjulia.dll" in (
+            windows_names
+        ) and not any(name.endswith(".so") for name in windows_names)
+        checks["the Linux zip holds dqjulia/lib/libdqjulia.so and no .dll"] = "dqjulia/lib/libdqjulia.so" in (
+            linux_names
+        ) and not any(name.endswith(".dll") for name in linux_names)
         checks["Windows manifest: platforms = %s" % platforms(windows)] = platforms(windows) == '["windows-x64"]'
         checks["Linux manifest: platforms = %s" % platforms(linux)] = platforms(linux) == '["linux-x64"]'
         shared = (windows_names & linux_names) - {"dqjulia/blender_manifest.toml", "dqjulia/schema.json"}
@@ -96,7 +96,8 @@ def main():
         schema = [json.loads(archive.read("dqjulia/schema.json")) for archive in (windows, linux)]
         checks["schema.json the same document (%d fields)" % len(schema[1].get("fields", []))] = schema[0] == schema[1]
         manifests = [archive.read("dqjulia/blender_manifest.toml").decode() for archive in (windows, linux)]
-        checks["the manifests differ only in platforms"] = manifests[0].replace('"windows-x64"', '"linux-x64"') == manifests[1]
+        same = manifests[0].replace('"windows-x64"', '"linux-x64"') == manifests[1]
+        checks["the manifests differ only in platforms"] = same
         shutil.rmtree(work, ignore_errors=True)
         windows.extractall(work)
 

@@ -72,7 +72,8 @@ def main():
     )
     status, output = run([*emulator, exe, *small, "--force"])
     checks["with --force it is replaced: exit %d %s" % (status, output.strip())] = status == 0
-    status, output = run([compare, "png", os.path.join(linux_dir, "fractal.png"), os.path.join(windows_dir, "fractal.png")])
+    pictures = [os.path.join(folder, "fractal.png") for folder in (linux_dir, windows_dir)]
+    status, output = run([compare, "png", *pictures])
     checks["the replaced picture is the new one (48x36)"] = status == 1 and "sizes differ" in output
 
     names = sorted(os.listdir(windows_dir))

@@ -118,7 +118,8 @@ void compareVdb(const std::string& first, const std::string& second) {
         check(gridA.type() == gridB.type() && gridA.getGridClass() == gridB.getGridClass(),
               "grid " + gridA.getName() + ": types or classes differ");
         check(gridA.transform() == gridB.transform(), "grid " + gridA.getName() + ": transforms differ");
-        check(gridA.activeVoxelCount() == gridB.activeVoxelCount(), "grid " + gridA.getName() + ": active voxels differ");
+        check(gridA.activeVoxelCount() == gridB.activeVoxelCount(),
+              "grid " + gridA.getName() + ": active voxels differ");
         const double scale = gridA.voxelSize()[0];
         if (gridA.isType<openvdb::FloatGrid>() && gridB.isType<openvdb::FloatGrid>())
             compareValues(static_cast<const openvdb::FloatGrid&>(gridA), static_cast<const openvdb::FloatGrid&>(gridB),

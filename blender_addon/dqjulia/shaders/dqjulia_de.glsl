@@ -236,7 +236,9 @@ DqjHit dqj_march(DqjFractal f, DqjTrace m, vec3 origin, vec3 direction) {
 }
 
 // Surface normal by central differences of the 3-D distance, one-sided where one probe is
-// inside (the DE is clamped to 0 there); the bounds' normal on a clipped face. Faces the ray.
+// inside (the DE is clamped to 0 there); the bounds' normal on a clipped face. Faces the ray:
+// one tipped past perpendicular (a surface seen edge on) is bent onto the silhouette, not
+// mirrored, as the core's facingRay (mirroring made one-pixel dark speckles).
 vec3 dqj_normal(DqjFractal f, DqjTrace m, DqjHit trace, vec3 p, vec3 direction, float eps) {
     vec3 gradient = vec3(0.0f);
     if (trace.cut) {
@@ -265,6 +267,11 @@ vec3 dqj_normal(DqjFractal f, DqjTrace m, DqjHit trace, vec3 p, vec3 direction, 
     }
     float len = length(gradient);
     vec3 normal = len > 0.0f && len < DQJ_HUGE ? gradient / len : -direction;
-    if (dot(normal, direction) > 0.0f) normal = -normal;
+    float along = dot(normal, direction);
+    if (along > 0.0f) {
+        vec3 bent = normal - along * direction;
+        float bent_length = length(bent);
+        normal = bent_length > 1.0e-6f ? bent / bent_length : -direction;
+    }
     return normal;
 }

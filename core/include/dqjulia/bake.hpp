@@ -17,8 +17,10 @@
 // parallel themselves. A memory estimate is checked before the heavy work (MemoryLimitError).
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 
@@ -39,11 +41,19 @@ struct BakeMonitor {
     std::atomic<std::uint64_t> dense{0};      ///< voxels a dense bake evaluates (set at the start)
 };
 
+/// One tile of a tiled bake (tiles.hpp): the whole bake's index box cut into
+/// counts[0] x counts[1] x counts[2] boxes, and which of them (1-based, x fastest).
+struct Tile {
+    std::array<int, 3> counts{1, 1, 1};
+    int index = 1;
+};
+
 struct BakeOptions {
     bool dense = false;                     ///< evaluate every voxel, skip nothing (for comparisons and tests)
     std::uint64_t memoryLimit = 0;          ///< refuse above this estimate, in bytes; 0 = defaultMemoryLimit()
     BakeMonitor* monitor = nullptr;         ///< optional live counters
     Existing existing = Existing::Replace;  ///< bakeVdb: replace an existing file, or keep it and fail
+    std::optional<Tile> tile;               ///< bakeVdb: bake this tile only (tiles.hpp); not for meshes
 };
 
 struct BakeStats {
@@ -84,8 +94,9 @@ DQJ_API std::string formatBytes(std::uint64_t bytes);
 
 /// Bakes `params` (validated; for an animation frame pass atFrame(params, frame)) into the
 /// OpenVDB file `path`, with the grids params.bake.grids names. The file appears only when
-/// complete (temporary file + rename). Throws ParamError, MemoryLimitError, Cancelled (the
-/// progress callback returned false) or std::runtime_error (I/O).
+/// complete (temporary file + rename). With options.tile, one tile of it (tiles.hpp).
+/// Throws ParamError, MemoryLimitError, Cancelled (the progress callback returned false) or
+/// std::runtime_error (I/O).
 DQJ_API BakeStats bakeVdb(const Params& params, const std::string& path, const BakeOptions& options = {},
                           const ProgressCallback& progress = {});
 

@@ -17,4 +17,8 @@ enum class Existing { Replace, Keep };
 /// std::runtime_error ("cannot write 'path': reason").
 DQJ_API void checkWritable(const std::string& path, Existing existing = Existing::Replace);
 
+/// Writes `text` to `path` as every writer does (a temporary file, published when complete).
+/// Throws std::runtime_error ("cannot write 'path': reason").
+DQJ_API void writeTextFile(const std::string& path, const std::string& text, Existing existing = Existing::Replace);
+
 }  // namespace dqj
