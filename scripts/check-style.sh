@@ -104,6 +104,30 @@ if [ ${#cxx[@]} -gt 0 ]; then
   fi
 fi
 
+# The project's own rule: no thread_local with a destructor in the library or the command. With
+# MinGW-w64 one corrupts the heap when its thread exits (GCC bug 80816); per-thread buffers are
+# ThreadScratch (core/src/thread_scratch.hpp). A thread_local of a trivially destructible type says
+# so on its line or the line before ("trivially destructible").
+in_ranges() {  # in_ranges FILE LINE: whether LINE is among FILE's changed lines (always with --all)
+  [ "$mode" = all ] && return 0
+  local range
+  for range in ${ranges[$1]:-}; do
+    [ "$2" -ge "${range%%:*}" ] && [ "$2" -le "${range##*:}" ] && return 0
+  done
+  return 1
+}
+for file in "${cxx[@]}"; do
+  case "$file" in core/*) ;; *) continue ;; esac
+  while IFS=: read -r line text; do
+    if in_ranges "$file" "$line"; then
+      echo "$file:$line: thread_local with a destructor breaks Windows builds; use ThreadScratch, or say" \
+        "\"trivially destructible\" on the line: $text"
+      failed=1
+    fi
+  done < <(awk '/(^|[^A-Za-z0-9_])thread_local([^A-Za-z0-9_]|$)/ && !/trivially destructible/ && previous !~ /trivially destructible/ { print FNR ":" $0 }
+                { previous = $0 }' "$file")
+done
+
 # ruff: lint findings on changed lines; format per changed range (ruff formats one range a run).
 if [ ${#python[@]} -gt 0 ]; then
   if [ -z "$ruff" ] || ! have "$ruff"; then
@@ -117,13 +141,10 @@ if [ ${#python[@]} -gt 0 ]; then
       while IFS= read -r finding; do
         [ -n "$finding" ] || continue
         file="${finding%%:*}" rest="${finding#*:}" line="${rest%%:*}"
-        for range in ${ranges[$file]:-}; do
-          if [ "$line" -ge "${range%%:*}" ] && [ "$line" -le "${range##*:}" ]; then
-            echo "$finding"
-            failed=1
-            break
-          fi
-        done
+        if in_ranges "$file" "$line"; then
+          echo "$finding"
+          failed=1
+        fi
       done <<< "$findings"
       for file in "${python[@]}"; do
         for range in ${ranges[$file]:-}; do

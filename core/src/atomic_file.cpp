@@ -167,6 +167,7 @@ std::string hiddenPrefix(const std::string& path) {
 }
 
 std::string randomSuffix() {
+    // A thread_local, as it is trivially destructible (scripts/check-style.sh): nothing runs at thread exit.
     static thread_local std::mt19937_64 generator{std::random_device{}() ^ (std::uint64_t(processId()) << 32)};
     static constexpr char kLetters[] = "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789";
     std::string suffix(6, 'x');
