@@ -100,11 +100,14 @@ void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, 
     const bool iterations = hasGrid(params.bake, BakeGrid::Iterations);
     if (!color && !trap && !iterations) return;
     if (progress && !progress(0.0)) throw Cancelled();
-    // The level set's distances over the attribute voxels (its band stops short of their depth).
-    // A tile sweeps over all it baked, its halo included, and keeps its box.
-    openvdb::MaskGrid voxels(std::make_shared<openvdb::MaskTree>(attributeVoxels(surface, params.bake)));
-    voxels.setTransform(surface.transform().copy());
-    const openvdb::FloatGrid::Ptr distance = openvdb::tools::maskSdf(surface, voxels);
+    // The sweep's domain: the level set grown to the attribute voxels (its band stops short of
+    // their depth). The sweep starts from the voxels next to the zero crossing and reads only the
+    // sign of the others, which the level set's inactive values already give (+-background), so
+    // the grown voxels need no distances of their own (a maskSdf pass first would be a second
+    // sweep over the same voxels). A tile sweeps over all it baked, its halo included, and keeps
+    // its box.
+    const openvdb::FloatGrid::Ptr distance = surface.deepCopy();
+    distance->tree().topologyUnion(attributeVoxels(surface, params.bake));
     const Slice slice = params.slice.effective();
     std::atomic<std::uint64_t> evaluated{0};
     // OpenVDB 10's sweep passes the functors index coordinates (it takes the transform of the
