@@ -13,6 +13,7 @@
 #include <mutex>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #ifdef _WIN32
@@ -90,6 +91,23 @@ openvdb::MaskTree attributeVoxels(const openvdb::FloatGrid& surface, const BakeS
     return mask;
 }
 
+using SurfaceAccessor = openvdb::tree::ValueAccessor<const openvdb::FloatTree>;
+
+/// A sweep's boundary functor with its own accessor to the level set: the sweep copies its
+/// functor once per thread, so each thread reads the level set through its own cache (the tree
+/// itself, read without one, starts every read at the root).
+template <typename F>
+struct WithAccessor {
+    F f;
+    mutable SurfaceAccessor accessor;
+    auto operator()(const openvdb::Vec3R& xyz) const { return f(accessor, xyz); }
+};
+
+template <typename F>
+WithAccessor<F> withAccessor(const openvdb::FloatTree& tree, F f) {
+    return WithAccessor<F>{std::move(f), SurfaceAccessor(tree)};
+}
+
 /// The attribute grids ("color", "trap", "iterations") on attributeVoxels(), within `kept` if
 /// given (a tile's), each an extension field: every voxel holds the value at the surface point
 /// nearest to it (OpenVDB's fast sweeping, along the distance's gradient), so the inside shows,
@@ -104,21 +122,24 @@ void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, 
     const bool iterations = hasGrid(params.bake, BakeGrid::Iterations);
     if (!color && !trap && !iterations) return;
     if (progress && !progress(0.0)) throw Cancelled();
-    // The level set's distances over the attribute voxels (its band stops short of their depth).
-    // A tile sweeps over all it baked, its halo included, and keeps its box.
-    openvdb::MaskGrid voxels(std::make_shared<openvdb::MaskTree>(attributeVoxels(surface, params.bake)));
-    voxels.setTransform(surface.transform().copy());
-    const openvdb::FloatGrid::Ptr distance = openvdb::tools::maskSdf(surface, voxels);
+    // The sweep's domain: the level set grown to the attribute voxels (its band stops short of
+    // their depth). The sweep starts from the voxels next to the zero crossing and reads only the
+    // sign of the others, which the level set's inactive values already give (+-background), so
+    // the grown voxels need no distances of their own (a maskSdf pass first would be a second
+    // sweep over the same voxels). A tile sweeps over all it baked, its halo included, and keeps
+    // its box.
+    const openvdb::FloatGrid::Ptr distance = surface.deepCopy();
+    distance->tree().topologyUnion(attributeVoxels(surface, params.bake));
     const Slice slice = params.slice.effective();
     std::atomic<std::uint64_t> evaluated{0};
     // OpenVDB 10's sweep passes the functors index coordinates (it takes the transform of the
     // extension grid it creates, which has none); the bake's grid is index * voxel size. The
     // orbit is taken kSurfaceColourOffset voxels outside, along the distance's gradient.
     const double h = surface.voxelSize()[0];
-    auto atSurface = [&](const openvdb::Vec3R& ijk) {
+    auto atSurface = [&](SurfaceAccessor& accessor, const openvdb::Vec3R& ijk) {
         ++evaluated;
         auto at = [&](double x, double y, double z) {
-            return double(openvdb::tools::BoxSampler::sample(surface.tree(), ijk + openvdb::Vec3R(x, y, z)));
+            return double(openvdb::tools::BoxSampler::sample(accessor, ijk + openvdb::Vec3R(x, y, z)));
         };
         glm::dvec3 gradient(at(0.5, 0, 0) - at(-0.5, 0, 0), at(0, 0.5, 0) - at(0, -0.5, 0),
                             at(0, 0, 0.5) - at(0, 0, -0.5));
@@ -136,20 +157,24 @@ void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, 
         return grid;
     };
     if (color) {
-        auto rgb = [&](const openvdb::Vec3R& xyz) {
-            const glm::dvec3 c = orbitColour(params.material, params.fractal, atSurface(xyz));
+        auto rgb = withAccessor(surface.tree(), [&](SurfaceAccessor& accessor, const openvdb::Vec3R& xyz) {
+            const glm::dvec3 c = orbitColour(params.material, params.fractal, atSurface(accessor, xyz));
             return openvdb::Vec3s(float(c.x), float(c.y), float(c.z));
-        };
+        });
         name(openvdb::tools::sdfToExt(*distance, rgb, openvdb::Vec3s(0.0f)), "color")
             ->setVectorType(openvdb::VEC_INVARIANT);
         if (progress && !progress(0.5)) throw Cancelled();
     }
     if (trap) {
-        auto value = [&](const openvdb::Vec3R& xyz) { return float(atSurface(xyz).trap); };
+        auto value = withAccessor(surface.tree(), [&](SurfaceAccessor& accessor, const openvdb::Vec3R& xyz) {
+            return float(atSurface(accessor, xyz).trap);
+        });
         name(openvdb::tools::sdfToExt(*distance, value, 0.0f), "trap");
     }
     if (iterations) {
-        auto value = [&](const openvdb::Vec3R& xyz) { return float(smoothIterations(params.fractal, atSurface(xyz))); };
+        auto value = withAccessor(surface.tree(), [&](SurfaceAccessor& accessor, const openvdb::Vec3R& xyz) {
+            return float(smoothIterations(params.fractal, atSurface(accessor, xyz)));
+        });
         name(openvdb::tools::sdfToExt(*distance, value, 0.0f), "iterations");
     }
     stats.evaluated += evaluated.load();

@@ -437,9 +437,11 @@ void SurfaceFunction::operator()(const glm::dvec3* points, std::size_t count, fl
                                  std::uint64_t& evaluations) const {
     BatchScratch& scratch = scratch_.local();
     BatchBuffer<double>& batch = scratch.batch;
-    std::vector<std::size_t>& evaluated = scratch.evaluated;
+    std::vector<std::size_t>& evaluated = scratch.evaluated;  // indices of the points inside the region
+    std::vector<double>& distances = scratch.distances;       // and their region distances, computed once
     batch.clear();
     evaluated.clear();
+    distances.clear();
     for (std::size_t i = 0; i < count; ++i) {
         const double regionDistance = region_.signedDistance(points[i]);
         if (regionDistance > 0.0) {
@@ -447,14 +449,13 @@ void SurfaceFunction::operator()(const glm::dvec3* points, std::size_t count, fl
         } else {
             batch.add(slice_.map(points[i]));
             evaluated.push_back(i);
+            distances.push_back(regionDistance);
         }
     }
     batch.evaluate(fractal_);
     evaluations += evaluated.size();
-    for (std::size_t k = 0; k < evaluated.size(); ++k) {
-        const std::size_t i = evaluated[k];
-        values[i] = value(batch.n(k), batch.de(k), region_.signedDistance(points[i]));
-    }
+    for (std::size_t k = 0; k < evaluated.size(); ++k)
+        values[evaluated[k]] = value(batch.n(k), batch.de(k), distances[k]);
 }
 
 CoordBBox bakeIndexBox(const Params& params) {

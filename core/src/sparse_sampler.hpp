@@ -73,6 +73,7 @@ private:
     struct BatchScratch {
         BatchBuffer<double> batch;
         std::vector<std::size_t> evaluated;
+        std::vector<double> distances;
     };
 
     Fractal fractal_;
