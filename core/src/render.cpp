@@ -19,6 +19,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -35,6 +36,10 @@ constexpr int kShadowSteps = 64;    // soft shadows are a look, not a measuremen
 constexpr int kBisectionSteps = 8;  // refines a step that landed inside to 1/256 of the step
 constexpr double kFootprintFloor = 1e-7;
 constexpr int kRaysPerPass = 1024;  // rays traced together: whole pixels of a tile
+constexpr int kConeBlock = 4;       // pixels per side of the blocks a cone pre-pass marches for
+/// A cone stops where its free margin (DE minus its radius) drops below this many hit
+/// thresholds: its rays then start well before any point where they could stop.
+constexpr double kConeMargin = 4.0;
 
 /// The normal turned towards the eye. A gradient that tips past perpendicular to the ray (a
 /// surface seen edge on, where the differences straddle a crease) is bent back onto the
@@ -132,6 +137,7 @@ public:
     }
 
     const CameraFrame& camera() const { return camera_; }
+    const Bounds& bounds() const { return bounds_; }
     int samples() const { return samples_; }
 
     /// Hit threshold at distance t from the eye: `detail` pixel footprints.
@@ -192,15 +198,33 @@ private:
 /// logarithm.
 class RayJob {
 public:
-    RayJob(const Scene& scene, const glm::dvec3& direction) : scene_(&scene), direction_(direction) {
+    /// A camera ray; `start`: where a cone pre-pass proved the way free (0: from the bounds).
+    RayJob(const Scene& scene, const glm::dvec3& direction, double start = 0.0)
+        : scene_(&scene), direction_(direction) {
         span_ = intersectSphere(scene.camera_.eye, direction, scene.bounds_);
-        if (!span_.valid || scene.empty_) {
+        if (!span_.valid || scene.empty_ || start > span_.far) {
             finishMarch();
             return;
         }
-        t_ = previousT_ = span_.near;
+        seeded_ = start > span_.near;
+        t_ = previousT_ = std::max(span_.near, start);
         stage_ = Stage::March;
     }
+
+    /// A cone pre-pass: marches the cone of half-width `spread` * t around `axis` over
+    /// [near, far] (its rays' spans) and stops where the set may come within reach of one of
+    /// its rays; coneStart() is then where those rays may start marching (+inf: all miss).
+    static RayJob cone(const Scene& scene, const glm::dvec3& axis, double spread, double near, double far) {
+        RayJob job(scene, axis, kInfinity);  // a miss: no stage yet
+        job.cone_ = true;
+        job.spread_ = spread;
+        job.span_ = {true, near, far};
+        job.t_ = near;
+        job.coneStart_ = near;
+        job.stage_ = scene.empty_ || !(near <= far) || !std::isfinite(near) ? Stage::Done : Stage::March;
+        return job;
+    }
+    double coneStart() const { return coneStart_; }
 
     bool done() const { return stage_ == Stage::Done; }
     const Trace& trace() const { return trace_; }
@@ -271,6 +295,10 @@ private:
     /// Sphere tracing: step by stepFactor * min(DE / stretch, maxStep) until the DE is below
     /// the hit threshold or the ray leaves the bounds.
     void answerMarch(const Probe& escape) {
+        if (cone_) {
+            answerCone(escape);
+            return;
+        }
         const RenderSettings& settings = scene_->settings_;
         ++trace_.steps;
         eps_ = scene_->epsilon(t_);
@@ -279,7 +307,7 @@ private:
             if (!havePrevious_) {
                 trace_.t = t_;
                 trace_.escape = escape;
-                trace_.cutFace = step_ == 0 && scene_->bounds_.clipped && span_.near > 0.0;
+                trace_.cutFace = step_ == 0 && !seeded_ && scene_->bounds_.clipped && span_.near > 0.0;
                 finishMarch();
                 return;
             }
@@ -315,6 +343,26 @@ private:
                 trace_.escape = previous_;
             }
             finishMarch();
+        }
+    }
+
+    /// Cone marching (the pre-pass): every ray of the cone lies within spread * t of the axis,
+    /// so the ball of radius DE around the axis point keeps it free for a step of
+    /// (DE - spread * t) / (1 + spread), with the rays' step factor and largest step.
+    void answerCone(const Probe& escape) {
+        const RenderSettings& settings = scene_->settings_;
+        double free = scene_->distance3(escape);
+        if (!std::isfinite(free)) free = settings.maxStep;  // zero derivative: as the rays do
+        free -= spread_ * t_;
+        coneStart_ = t_;
+        if (escape.n == 0 || free < kConeMargin * scene_->epsilon(t_) || ++step_ == settings.maxSteps) {
+            stage_ = Stage::Done;
+            return;
+        }
+        t_ += settings.stepFactor * std::min(free / (1.0 + spread_), settings.maxStep);
+        if (t_ > span_.far) {
+            coneStart_ = kInfinity;  // the cone leaves the bounds: every ray of it misses
+            stage_ = Stage::Done;
         }
     }
 
@@ -471,6 +519,10 @@ private:
     const Scene* scene_;
     glm::dvec3 direction_;
     Stage stage_ = Stage::Done;
+    bool seeded_ = false;  // starts where a cone stopped, not on the bounds
+    bool cone_ = false;    // a cone of the pre-pass, not a camera ray
+    double spread_ = 0.0;
+    double coneStart_ = 0.0;
     Trace trace_;
     // Sphere tracing and bisection.
     Interval span_;
@@ -500,12 +552,16 @@ private:
 /// Holds only buffers, so one per thread is reused from tile to tile.
 class Evaluator {
 public:
+    /// Evaluations answered since the last call (all of them: rays, cones, shading).
+    std::uint64_t takeEvaluations() { return std::exchange(evaluations_, 0); }
+
     void run(const Scene& scene, RenderEngine engine, std::vector<RayJob>& jobs) {
         if (engine == RenderEngine::Scalar) {
             for (RayJob& job : jobs) {
                 while (!job.done()) {
                     points_.clear();
                     job.queries(points_);
+                    evaluations_ += points_.size();
                     probes_.clear();
                     for (const glm::dvec3& p : points_) probes_.push_back(Probe::of(scene.evaluateAt(p)));
                     job.answer(probes_.data());
@@ -520,6 +576,7 @@ public:
             points_.clear();
             counts_.clear();
             for (const std::size_t index : active_) counts_.push_back(jobs[index].queries(points_));
+            evaluations_ += points_.size();
             evaluateBatch(scene);
             std::size_t offset = 0;
             std::size_t kept = 0;
@@ -562,12 +619,14 @@ private:
     std::vector<std::size_t> counts_;
     std::vector<std::size_t> active_;
     BatchBuffer<double> batch_;
+    std::uint64_t evaluations_ = 0;
 };
 
 struct TileStats {
     std::uint64_t rays = 0;
     std::uint64_t steps = 0;
     std::uint64_t hitPixels = 0;
+    std::uint64_t evaluations = 0;
 };
 
 TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, int x1, int y1, Image& image) {
@@ -582,20 +641,48 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
     const int pixelsPerPass = std::max(1, kRaysPerPass / perPixel);
     thread_local Evaluator evaluator;
     thread_local std::vector<RayJob> jobs;
+    auto sampleDirection = [&](int x, int y, int sx, int sy) {
+        // A regular grid of sub-pixel positions; with one sample, the pixel centre.
+        return camera.rayDirection(x + (sx + 0.5) / samples, y + (sy + 0.5) / samples);
+    };
+    // The cone pre-pass: one cone around each block of kConeBlock^2 pixels finds how far all
+    // their rays may go before they can come near the set.
+    const int blocksX = (width + kConeBlock - 1) / kConeBlock;
+    const int blocksY = (y1 - y0 + kConeBlock - 1) / kConeBlock;
+    jobs.clear();
+    for (int by = 0; by < blocksY; ++by) {
+        for (int bx = 0; bx < blocksX; ++bx) {
+            const int bx0 = x0 + bx * kConeBlock, by0 = y0 + by * kConeBlock;
+            const int bx1 = std::min(x1, bx0 + kConeBlock), by1 = std::min(y1, by0 + kConeBlock);
+            const glm::dvec3 axis = camera.rayDirection(0.5 * (bx0 + bx1), 0.5 * (by0 + by1));
+            double spread = 0.0;  // the farthest corner: a ray at t is within spread * t of the axis
+            for (const int cy : {by0, by1})
+                for (const int cx : {bx0, bx1})
+                    spread = std::max(spread, glm::length(camera.rayDirection(cx, cy) - axis));
+            // Its rays meet the bounds only where the axis comes within radius + spread * t of
+            // the centre: the axis through the sphere grown by its spread at the farthest t.
+            Bounds grown = scene.bounds();
+            grown.radius += spread * (glm::length(camera.eye - grown.center) + grown.radius);
+            const Interval span = intersectSphere(camera.eye, axis, grown);
+            const double near = span.valid ? span.near : kInfinity;
+            const double far = span.valid ? span.far : kInfinity;
+            jobs.push_back(RayJob::cone(scene, axis, 1.01 * spread, near, far));
+        }
+    }
+    evaluator.run(scene, engine, jobs);
+    thread_local std::vector<double> starts;
+    starts.clear();
+    for (const RayJob& job : jobs) starts.push_back(job.coneStart());
     for (int first = 0; first < pixels; first += pixelsPerPass) {
         const int last = std::min(pixels, first + pixelsPerPass);
         jobs.clear();
         for (int index = first; index < last; ++index) {
             const int x = x0 + index % width;
             const int y = y0 + index / width;
-            for (int sy = 0; sy < samples; ++sy) {
-                for (int sx = 0; sx < samples; ++sx) {
-                    // A regular grid of sub-pixel positions; with one sample, the pixel centre.
-                    const double px = x + (sx + 0.5) / samples;
-                    const double py = y + (sy + 0.5) / samples;
-                    jobs.emplace_back(scene, camera.rayDirection(px, py));
-                }
-            }
+            const std::size_t block = static_cast<std::size_t>((y - y0) / kConeBlock) * blocksX + (x - x0) / kConeBlock;
+            const double start = starts[block];
+            for (int sy = 0; sy < samples; ++sy)
+                for (int sx = 0; sx < samples; ++sx) jobs.emplace_back(scene, sampleDirection(x, y, sx, sy), start);
         }
         evaluator.run(scene, engine, jobs);
         for (int index = first; index < last; ++index) {
@@ -633,6 +720,7 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
             if (hits > 0) ++stats.hitPixels;
         }
     }
+    stats.evaluations = evaluator.takeEvaluations();
     return stats;
 }
 
@@ -698,6 +786,7 @@ RenderResult render(const Params& params, const ProgressCallback& progress, Rend
     std::atomic<std::uint64_t> rays{0};
     std::atomic<std::uint64_t> steps{0};
     std::atomic<std::uint64_t> hitPixels{0};
+    std::atomic<std::uint64_t> evaluations{0};
     parallelForWithProgress(static_cast<std::size_t>(tilesX) * tilesY, progress,
                             [&](std::size_t index, const std::atomic<bool>&) {
                                 const int x0 = static_cast<int>(index % tilesX) * kTileSize;
@@ -708,11 +797,13 @@ RenderResult render(const Params& params, const ProgressCallback& progress, Rend
                                 rays += tile.rays;
                                 steps += tile.steps;
                                 hitPixels += tile.hitPixels;
+                                evaluations += tile.evaluations;
                             });
 
     result.stats.rays = rays;
     result.stats.steps = steps;
     result.stats.hitPixels = hitPixels;
+    result.stats.evaluations = evaluations;
     result.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
 }
