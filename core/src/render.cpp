@@ -671,16 +671,22 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
     }
     evaluator.run(scene, engine, jobs);
     thread_local std::vector<double> starts;
+    thread_local std::vector<std::size_t> firstJob;  // per pixel of the pass: its first job, or kNoJob
+    constexpr std::size_t kNoJob = std::numeric_limits<std::size_t>::max();
     starts.clear();
     for (const RayJob& job : jobs) starts.push_back(job.coneStart());
     for (int first = 0; first < pixels; first += pixelsPerPass) {
         const int last = std::min(pixels, first + pixelsPerPass);
         jobs.clear();
+        firstJob.clear();
         for (int index = first; index < last; ++index) {
             const int x = x0 + index % width;
             const int y = y0 + index / width;
             const std::size_t block = static_cast<std::size_t>((y - y0) / kConeBlock) * blocksX + (x - x0) / kConeBlock;
             const double start = starts[block];
+            // A pixel whose cone left the bounds misses with every sample: no rays to trace.
+            firstJob.push_back(start == kInfinity ? kNoJob : jobs.size());
+            if (start == kInfinity) continue;
             for (int sy = 0; sy < samples; ++sy)
                 for (int sx = 0; sx < samples; ++sx) jobs.emplace_back(scene, sampleDirection(x, y, sx, sy), start);
         }
@@ -693,8 +699,13 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
             glm::dvec3 normalSum(0.0);
             double depth = kInfinity;
             int hits = 0;
-            for (int sample = 0; sample < perPixel; ++sample) {
-                const RayJob& job = jobs[static_cast<std::size_t>(index - first) * perPixel + sample];
+            const std::size_t pixelJobs = firstJob[static_cast<std::size_t>(index - first)];
+            for (int sample = 0; sample < perPixel && pixelJobs == kNoJob; ++sample) {
+                ++stats.rays;  // the background, as a missing ray's job would give it
+                colour += scene.background(sampleDirection(x, y, sample % samples, sample / samples));
+            }
+            for (int sample = 0; sample < perPixel && pixelJobs != kNoJob; ++sample) {
+                const RayJob& job = jobs[pixelJobs + sample];
                 ++stats.rays;
                 stats.steps += job.trace().steps;
                 colour += job.colour();
