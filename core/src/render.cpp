@@ -226,7 +226,34 @@ public:
     }
     double coneStart() const { return coneStart_; }
 
-    bool done() const { return stage_ == Stage::Done; }
+    /// No more queries: finished, or paused before its shading (pausesBeforeShading()).
+    bool done() const { return stage_ == Stage::Done || stage_ == Stage::Paused; }
+    bool paused() const { return stage_ == Stage::Paused; }
+
+    /// Goes on from the pause to its own occlusion and shadows.
+    void resumeShading() {
+        if (stage_ == Stage::Paused) beginShading();
+    }
+
+    /// Whether this paused sample may take the occlusion and shadows of `other`, a sample of the
+    /// same pixel shaded already: both on one piece of surface (hit points within two hit
+    /// thresholds, normals within 18 degrees) facing the same lights.
+    bool canShareShading(const RayJob& other) const {
+        if (!paused() || other.stage_ != Stage::Done || !other.trace_.hit) return false;
+        const double reach = 2.0 * std::max(hitEps_, other.hitEps_);
+        if (glm::length(p_ - other.p_) > reach || glm::dot(normal_, other.normal_) < 0.95) return false;
+        for (const auto& light : scene_->lights_)
+            if ((glm::dot(normal_, light.direction) > 0.0) != (glm::dot(other.normal_, light.direction) > 0.0))
+                return false;
+        return true;
+    }
+
+    /// Shades this paused sample with the occlusion and shadows of `other` (canShareShading()).
+    void shareShading(const RayJob& other) {
+        open_ = other.open_;
+        shadows_ = other.shadows_;
+        finishShading();
+    }
     const Trace& trace() const { return trace_; }
     /// The shaded colour for a hit, the background for a miss.
     const glm::dvec3& colour() const { return colour_; }
@@ -259,6 +286,7 @@ public:
                 }
                 return count;
             }
+            case Stage::Paused:
             case Stage::Done: return 0;
         }
         return 0;
@@ -272,12 +300,13 @@ public:
             case Stage::Normal: answerNormal(escapes); return;
             case Stage::Occlusion: answerOcclusion(escapes); return;
             case Stage::Shadows: answerShadows(escapes); return;
+            case Stage::Paused:
             case Stage::Done: return;
         }
     }
 
 private:
-    enum class Stage { March, Bisect, Normal, Occlusion, Shadows, Done };
+    enum class Stage { March, Bisect, Normal, Occlusion, Shadows, Paused, Done };
 
     /// A soft-shadow march towards one directional light: 0 = blocked, 1 = lit; penumbra from
     /// the closest miss along the way (k * d / t).
@@ -427,6 +456,17 @@ private:
         const double length = glm::length(gradient);
         normal_ = length > 0.0 && std::isfinite(length) ? gradient / length : -direction_;
         normal_ = facingRay(normal_, direction_);
+        // With several samples a pixel, one of them shades first and the others may share its
+        // occlusion and shadows (renderTile): they wait here.
+        const Material& material = scene_->material_;
+        if (scene_->samples_ > 1 && (material.occlusion > 0.0 || material.shadows) && !scene_->lights_.empty()) {
+            stage_ = Stage::Paused;
+            return;
+        }
+        beginShading();
+    }
+
+    void beginShading() {
         if (scene_->material_.occlusion > 0.0) {
             stage_ = Stage::Occlusion;
         } else {
@@ -691,6 +731,39 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
                 for (int sx = 0; sx < samples; ++sx) jobs.emplace_back(scene, sampleDirection(x, y, sx, sy), start);
         }
         evaluator.run(scene, engine, jobs);
+        // Occlusion and shadows vary slowly over the surface: the first sample of a pixel to
+        // hit shades itself, the pixel's others on the same piece of surface take its values.
+        bool paused = false;
+        for (int index = first; index < last; ++index) {
+            const std::size_t pixelJobs = firstJob[static_cast<std::size_t>(index - first)];
+            for (int sample = 0; sample < perPixel && pixelJobs != kNoJob; ++sample) {
+                if (!jobs[pixelJobs + sample].paused()) continue;
+                jobs[pixelJobs + sample].resumeShading();
+                paused = true;
+                break;
+            }
+        }
+        if (paused) {
+            evaluator.run(scene, engine, jobs);
+            for (int index = first; index < last; ++index) {
+                const std::size_t pixelJobs = firstJob[static_cast<std::size_t>(index - first)];
+                if (pixelJobs == kNoJob) continue;
+                const RayJob* leader = nullptr;
+                for (int sample = 0; sample < perPixel; ++sample) {
+                    RayJob& job = jobs[pixelJobs + sample];
+                    if (!job.paused()) {
+                        if (leader == nullptr && job.trace().hit) leader = &job;
+                        continue;
+                    }
+                    if (leader != nullptr && job.canShareShading(*leader)) {
+                        job.shareShading(*leader);
+                    } else {
+                        job.resumeShading();
+                    }
+                }
+            }
+            evaluator.run(scene, engine, jobs);
+        }
         for (int index = first; index < last; ++index) {
             const int x = x0 + index % width;
             const int y = y0 + index / width;
