@@ -33,6 +33,9 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr int kTileSize = 16;
 constexpr int kOcclusionSamples = 5;
 constexpr int kShadowSteps = 64;    // soft shadows are a look, not a measurement: cap their cost
+/// Shadow marches step by this many DEs (over-relaxed; the DE is about half the distance) and
+/// fall back to the plain step where two consecutive free balls do not overlap.
+constexpr double kShadowRelaxation = 1.6;
 constexpr int kBisectionSteps = 8;  // refines a step that landed inside to 1/256 of the step
 constexpr double kFootprintFloor = 1e-7;
 constexpr int kRaysPerPass = 1024;  // rays traced together: whole pixels of a tile
@@ -319,6 +322,12 @@ private:
         int step = 0;
         bool done = true;
         double lit = 1.0;
+        // Over-relaxation: the last point marched from, its DE and plain step, and whether the
+        // step from it was the long one (checked when its point is answered).
+        double previousT = 0.0;
+        double previousD = 0.0;
+        double plainStep = 0.0;
+        bool relaxed = false;
     };
 
     /// Sphere tracing: step by stepFactor * min(DE / stretch, maxStep) until the DE is below
@@ -525,12 +534,25 @@ private:
             const Probe& escape = *escapes++;
             double d = escape.de / scene.stretch_;
             if (!std::isfinite(d)) d = scene.settings_.maxStep;
-            if (escape.n == 0 || d < 0.25 * hitEps_) {
+            const bool blocked = escape.n == 0 || d < 0.25 * hitEps_;
+            if (shadow.relaxed && (blocked || shadow.t - shadow.previousT > shadow.previousD + d)) {
+                // The long step may have passed an occluder (its free ball and the last one do
+                // not overlap, or it landed on the set): take the plain step from the last point.
+                shadow.t = shadow.previousT + shadow.plainStep;
+                shadow.relaxed = false;
+                shadow.done = !(++shadow.step < kShadowSteps && shadow.t < shadow.far);
+            } else if (blocked) {
                 shadow.result = 0.0;
                 shadow.done = true;
             } else {
                 shadow.result = std::min(shadow.result, scene.material_.shadowSoftness * d / shadow.t);
-                shadow.t += std::clamp(scene.settings_.stepFactor * d, hitEps_, scene.settings_.maxStep);
+                const double plain = std::clamp(scene.settings_.stepFactor * d, hitEps_, scene.settings_.maxStep);
+                const double relaxed = std::clamp(kShadowRelaxation * d, hitEps_, scene.settings_.maxStep);
+                shadow.previousT = shadow.t;
+                shadow.previousD = d;
+                shadow.plainStep = plain;
+                shadow.relaxed = relaxed > plain && shadow.t + relaxed < shadow.far;
+                shadow.t += shadow.relaxed ? relaxed : plain;
                 shadow.done = !(++shadow.step < kShadowSteps && shadow.t < shadow.far);
             }
             if (shadow.done) shadow.lit = std::clamp(shadow.result, 0.0, 1.0);
