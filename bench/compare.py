@@ -373,8 +373,10 @@ def render_rows(args, dqjulia, work, rows, label, case, defaults):
                  f"{cpu_ratio:.2f}x less CPU", "", None))
     if args.baseline:
         before = times["baseline"]["wall"] / times["dqjulia"]["wall"]
+        before_cpu = times["baseline"]["cpu"] / times["dqjulia"]["cpu"]
         rows.append((f"render{label} vs --baseline wall s", f"{times['dqjulia']['wall']:.3f}",
-                     f"baseline {times['baseline']['wall']:.3f}", f"{before:.2f}x faster", "", None))
+                     f"baseline {times['baseline']['wall']:.3f}", f"{before:.2f}x faster (CPU {before_cpu:.2f}x)", "",
+                     None))
     rows.append((f"render{label} silhouette IoU", f"{overlap:.4f}", "", "same object" if overlap > 0.9 else "DIFFERENT",
                  "> 0.9", overlap > 0.9))
     rows.append((f"render{label} speckle (object px)", f"{100 * ours_speckle:.3f}%", f"POV-Ray {100 * pov_speckle:.3f}%",
