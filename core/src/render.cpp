@@ -142,6 +142,7 @@ public:
     const CameraFrame& camera() const { return camera_; }
     const Bounds& bounds() const { return bounds_; }
     int samples() const { return samples_; }
+    std::size_t lightCount() const { return lights_.size(); }
 
     /// Hit threshold at distance t from the eye: `detail` pixel footprints.
     double epsilon(double t) const { return std::max(settings_.detail * t * footprint_, kFootprintFloor); }
@@ -191,6 +192,24 @@ private:
     double occlusionDelta_ = 0.02;
 };
 
+/// A soft-shadow march towards one directional light: 0 = blocked, 1 = lit; penumbra from
+/// the closest miss along the way (k * d / t). It starts from its ray's shadow origin and goes
+/// along the light's direction (both the same for every light of a ray: not stored here).
+struct ShadowMarch {
+    double far = 0.0;
+    double t = 0.0;
+    double result = 1.0;
+    double lit = 1.0;
+    // Over-relaxation: the last point marched from, its DE and plain step, and whether the
+    // step from it was the long one (checked when its point is answered).
+    double previousT = 0.0;
+    double previousD = 0.0;
+    double plainStep = 0.0;
+    int step = 0;
+    bool done = true;
+    bool relaxed = false;
+};
+
 /// One camera ray, from the eye to its shaded colour, as a state machine. Each stage names the
 /// 3-D points whose escape it needs next (queries()) and moves on when given their escapes
 /// (answer()): sphere tracing, bisecting back to the surface, the normal's probes (central
@@ -202,8 +221,10 @@ private:
 class RayJob {
 public:
     /// A camera ray; `start`: where a cone pre-pass proved the way free (0: from the bounds).
-    RayJob(const Scene& scene, const glm::dvec3& direction, double start = 0.0)
-        : scene_(&scene), direction_(direction) {
+    /// `shadows`: room for one shadow march per light of the scene, owned by the caller (a pool
+    /// reused from pass to pass: no allocation per ray).
+    RayJob(const Scene& scene, const glm::dvec3& direction, double start, ShadowMarch* shadows)
+        : scene_(&scene), direction_(direction), shadows_(shadows) {
         span_ = intersectSphere(scene.camera_.eye, direction, scene.bounds_);
         if (!span_.valid || scene.empty_ || start > span_.far) {
             finishMarch();
@@ -218,7 +239,7 @@ public:
     /// [near, far] (its rays' spans) and stops where the set may come within reach of one of
     /// its rays; coneStart() is then where those rays may start marching (+inf: all miss).
     static RayJob cone(const Scene& scene, const glm::dvec3& axis, double spread, double near, double far) {
-        RayJob job(scene, axis, kInfinity);  // a miss: no stage yet
+        RayJob job(scene, axis, kInfinity, nullptr);  // a miss: no stage yet; no shading
         job.cone_ = true;
         job.spread_ = spread;
         job.span_ = {true, near, far};
@@ -254,7 +275,7 @@ public:
     /// Shades this paused sample with the occlusion and shadows of `other` (canShareShading()).
     void shareShading(const RayJob& other) {
         open_ = other.open_;
-        shadows_ = other.shadows_;
+        std::copy(other.shadows_, other.shadows_ + scene_->lights_.size(), shadows_);
         finishShading();
     }
     const Trace& trace() const { return trace_; }
@@ -282,9 +303,11 @@ public:
                 return kOcclusionSamples;
             case Stage::Shadows: {
                 std::size_t count = 0;
-                for (const ShadowMarch& shadow : shadows_) {
+                const std::size_t lights = scene_->lights_.size();
+                for (std::size_t index = 0; index < lights; ++index) {
+                    const ShadowMarch& shadow = shadows_[index];
                     if (shadow.done) continue;
-                    points.push_back(shadow.origin + shadow.t * shadow.toLight);
+                    points.push_back(shadowOrigin_ + shadow.t * scene_->lights_[index].direction);
                     ++count;
                 }
                 return count;
@@ -310,25 +333,6 @@ public:
 
 private:
     enum class Stage { March, Bisect, Normal, Occlusion, Shadows, Paused, Done };
-
-    /// A soft-shadow march towards one directional light: 0 = blocked, 1 = lit; penumbra from
-    /// the closest miss along the way (k * d / t).
-    struct ShadowMarch {
-        glm::dvec3 origin{0.0};
-        glm::dvec3 toLight{0.0};
-        double far = 0.0;
-        double t = 0.0;
-        double result = 1.0;
-        int step = 0;
-        bool done = true;
-        double lit = 1.0;
-        // Over-relaxation: the last point marched from, its DE and plain step, and whether the
-        // step from it was the long one (checked when its point is answered).
-        double previousT = 0.0;
-        double previousD = 0.0;
-        double plainStep = 0.0;
-        bool relaxed = false;
-    };
 
     /// Sphere tracing: step by stepFactor * min(DE / stretch, maxStep) until the DE is below
     /// the hit threshold or the ray leaves the bounds.
@@ -504,15 +508,14 @@ private:
     /// One shadow march for every light the surface faces (when shadows are on).
     void startShadows() {
         const Scene& scene = *scene_;
-        shadows_.assign(scene.lights_.size(), ShadowMarch{});
+        std::fill(shadows_, shadows_ + scene.lights_.size(), ShadowMarch{});
+        shadowOrigin_ = p_ + normal_ * (2.0 * hitEps_);
         bool marching = false;
         for (std::size_t index = 0; index < scene.lights_.size(); ++index) {
             const glm::dvec3& toLight = scene.lights_[index].direction;
             if (!scene.material_.shadows || glm::dot(normal_, toLight) <= 0.0) continue;
             ShadowMarch& shadow = shadows_[index];
-            shadow.origin = p_ + normal_ * (2.0 * hitEps_);
-            shadow.toLight = toLight;
-            const Interval span = intersectSphere(shadow.origin, toLight, scene.bounds_);
+            const Interval span = intersectSphere(shadowOrigin_, toLight, scene.bounds_);
             if (!span.valid) continue;
             shadow.far = span.far;
             shadow.t = 2.0 * hitEps_;
@@ -529,7 +532,8 @@ private:
     void answerShadows(const Probe* escapes) {
         const Scene& scene = *scene_;
         bool marching = false;
-        for (ShadowMarch& shadow : shadows_) {
+        for (std::size_t index = 0; index < scene.lights_.size(); ++index) {
+            ShadowMarch& shadow = shadows_[index];
             if (shadow.done) continue;
             const Probe& escape = *escapes++;
             double d = escape.de / scene.stretch_;
@@ -605,7 +609,8 @@ private:
     double hitEps_ = 0.0;
     double h_ = 0.0;  // central-difference step
     double open_ = 1.0;
-    std::vector<ShadowMarch> shadows_;  // one per light
+    glm::dvec3 shadowOrigin_{0.0};    // where the shadow marches start: just off the surface
+    ShadowMarch* shadows_ = nullptr;  // one per light (the caller's pool)
 };
 
 /// Answers the queries of ray jobs until every job is done: one query at a time with evaluate()
@@ -703,6 +708,10 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
     const int pixelsPerPass = std::max(1, kRaysPerPass / perPixel);
     thread_local Evaluator evaluator;
     thread_local std::vector<RayJob> jobs;
+    // Room for the shadow marches of a pass's rays: job k has the lights' slots from k * lights.
+    thread_local std::vector<ShadowMarch> shadowSlots;
+    const std::size_t lights = scene.lightCount();
+    shadowSlots.resize(std::max(shadowSlots.size(), static_cast<std::size_t>(pixelsPerPass) * perPixel * lights));
     auto sampleDirection = [&](int x, int y, int sx, int sy) {
         // A regular grid of sub-pixel positions; with one sample, the pixel centre.
         return camera.rayDirection(x + (sx + 0.5) / samples, y + (sy + 0.5) / samples);
@@ -750,7 +759,9 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
             firstJob.push_back(start == kInfinity ? kNoJob : jobs.size());
             if (start == kInfinity) continue;
             for (int sy = 0; sy < samples; ++sy)
-                for (int sx = 0; sx < samples; ++sx) jobs.emplace_back(scene, sampleDirection(x, y, sx, sy), start);
+                for (int sx = 0; sx < samples; ++sx)
+                    jobs.emplace_back(scene, sampleDirection(x, y, sx, sy), start,
+                                      shadowSlots.data() + jobs.size() * lights);
         }
         evaluator.run(scene, engine, jobs);
         // Occlusion and shadows vary slowly over the surface: the first sample of a pixel to
