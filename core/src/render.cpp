@@ -636,24 +636,33 @@ public:
             }
             return;
         }
+        // Each job is visited once a round: it takes its answers and names its next queries at
+        // once, into the other points buffer, while its state is at hand.
         active_.clear();
-        for (std::size_t index = 0; index < jobs.size(); ++index)
-            if (!jobs[index].done()) active_.push_back(index);
+        points_.clear();
+        counts_.clear();
+        for (std::size_t index = 0; index < jobs.size(); ++index) {
+            if (jobs[index].done()) continue;
+            active_.push_back(index);
+            counts_.push_back(jobs[index].queries(points_));
+        }
         while (!active_.empty()) {
-            points_.clear();
-            counts_.clear();
-            for (const std::size_t index : active_) counts_.push_back(jobs[index].queries(points_));
             evaluations_ += points_.size();
             evaluateBatch(scene);
+            nextPoints_.clear();
             std::size_t offset = 0;
             std::size_t kept = 0;
             for (std::size_t k = 0; k < active_.size(); ++k) {
                 RayJob& job = jobs[active_[k]];
                 job.answer(probes_.data() + offset);
                 offset += counts_[k];
-                if (!job.done()) active_[kept++] = active_[k];
+                if (job.done()) continue;
+                active_[kept] = active_[k];
+                counts_[kept++] = job.queries(nextPoints_);
             }
             active_.resize(kept);
+            counts_.resize(kept);
+            std::swap(points_, nextPoints_);
         }
     }
 
@@ -665,14 +674,34 @@ private:
         const std::size_t count = points_.size();
         const Slice& slice = scene.slice();
         batch_.resize(count);
+        const glm::dvec3* points = points_.data();
         for (int k = 0; k < 8; ++k) {
             double* out = batch_.start(k);
             const double origin = slice.origin[k];
-            std::fill(out, out + count, origin);
+            // One pass a coordinate: origin + p[a] * scale over its nonzero axes, in axis order
+            // (the same sums as adding one axis after the other).
+            int axes[3];
+            double scales[3];
+            int terms = 0;
             for (int axis = 0; axis < 3; ++axis) {
-                const double scale = slice.axes[axis][k];
-                if (scale == 0.0) continue;
-                for (std::size_t i = 0; i < count; ++i) out[i] += points_[i][axis] * scale;
+                if (slice.axes[axis][k] == 0.0) continue;
+                axes[terms] = axis;
+                scales[terms++] = slice.axes[axis][k];
+            }
+            switch (terms) {
+                case 0: std::fill(out, out + count, origin); break;
+                case 1:
+                    for (std::size_t i = 0; i < count; ++i) out[i] = origin + points[i][axes[0]] * scales[0];
+                    break;
+                case 2:
+                    for (std::size_t i = 0; i < count; ++i)
+                        out[i] = origin + points[i][axes[0]] * scales[0] + points[i][axes[1]] * scales[1];
+                    break;
+                default:
+                    for (std::size_t i = 0; i < count; ++i)
+                        out[i] = origin + points[i][axes[0]] * scales[0] + points[i][axes[1]] * scales[1] +
+                                 points[i][axes[2]] * scales[2];
+                    break;
             }
         }
         batch_.evaluate(scene.fractal());
@@ -682,6 +711,7 @@ private:
     }
 
     std::vector<glm::dvec3> points_;
+    std::vector<glm::dvec3> nextPoints_;  // the next round's, filled while answering this one
     std::vector<Probe> probes_;
     std::vector<std::size_t> counts_;
     std::vector<std::size_t> active_;
