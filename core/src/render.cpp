@@ -14,9 +14,12 @@
 #include "dqjulia/inspect.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
 #include <utility>
@@ -678,6 +681,13 @@ private:
         for (int k = 0; k < 8; ++k) {
             double* out = batch_.start(k);
             const double origin = slice.origin[k];
+            // A coordinate the slice does not move (5 of 8 on the usual slices) keeps its value
+            // from round to round: the kernel only reads the start points, so only the entries
+            // past those already holding this origin are written.
+            constants_[k] = std::min(constants_[k], count);
+            if (constants_[k] > 0 &&
+                std::bit_cast<std::uint64_t>(constantOrigin_[k]) != std::bit_cast<std::uint64_t>(origin))
+                constants_[k] = 0;
             // One pass a coordinate: origin + p[a] * scale over its nonzero axes, in axis order
             // (the same sums as adding one axis after the other).
             int axes[3];
@@ -688,8 +698,14 @@ private:
                 axes[terms] = axis;
                 scales[terms++] = slice.axes[axis][k];
             }
+            if (terms == 0) {
+                std::fill(out + constants_[k], out + count, origin);
+                constants_[k] = count;
+                constantOrigin_[k] = origin;
+                continue;
+            }
+            constants_[k] = 0;
             switch (terms) {
-                case 0: std::fill(out, out + count, origin); break;
                 case 1:
                     for (std::size_t i = 0; i < count; ++i) out[i] = origin + points[i][axes[0]] * scales[0];
                     break;
@@ -716,6 +732,10 @@ private:
     std::vector<std::size_t> counts_;
     std::vector<std::size_t> active_;
     BatchBuffer<double> batch_;
+    // Per 8-D coordinate: how many leading start points hold constantOrigin_ (a coordinate the
+    // slice does not move), still valid from the last round.
+    std::array<std::size_t, 8> constants_{};
+    std::array<double, 8> constantOrigin_{};
     std::uint64_t evaluations_ = 0;
 };
 
