@@ -59,6 +59,20 @@ glm::dvec3 facingRay(const glm::dvec3& normal, const glm::dvec3& direction) {
     return length > 1e-6 ? bent / length : -direction;
 }
 
+/// CameraFrame::rayDirection in parts: the image plane's x of a pixel column, its y of a row,
+/// and the direction through (x, y). A tile works its columns and rows out once; the same
+/// expressions give the same directions, bit for bit.
+double screenX(const CameraFrame& camera, double px) {
+    const double aspect = static_cast<double>(camera.width) / camera.height;
+    return (2.0 * px / camera.width - 1.0) * camera.tanHalfFov * aspect;
+}
+double screenY(const CameraFrame& camera, double py) {
+    return (1.0 - 2.0 * py / camera.height) * camera.tanHalfFov;  // image rows go down, `up` goes up
+}
+glm::dvec3 screenDirection(const CameraFrame& camera, double x, double y) {
+    return glm::normalize(camera.forward + x * camera.right + y * camera.up);
+}
+
 /// Where a ray meets a sphere: [near, far] along the ray, or nothing.
 struct Interval {
     bool valid = false;
@@ -762,9 +776,19 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
     thread_local std::vector<ShadowMarch> shadowSlots;
     const std::size_t lights = scene.lightCount();
     shadowSlots.resize(std::max(shadowSlots.size(), static_cast<std::size_t>(pixelsPerPass) * perPixel * lights));
+    // A regular grid of sub-pixel positions; with one sample, the pixel centre. Their image
+    // plane coordinates, per sub-pixel column and row of the tile, are worked out once.
+    thread_local std::vector<double> columnX;
+    thread_local std::vector<double> rowY;
+    columnX.clear();
+    rowY.clear();
+    for (int x = x0; x < x1; ++x)
+        for (int sx = 0; sx < samples; ++sx) columnX.push_back(screenX(camera, x + (sx + 0.5) / samples));
+    for (int y = y0; y < y1; ++y)
+        for (int sy = 0; sy < samples; ++sy) rowY.push_back(screenY(camera, y + (sy + 0.5) / samples));
     auto sampleDirection = [&](int x, int y, int sx, int sy) {
-        // A regular grid of sub-pixel positions; with one sample, the pixel centre.
-        return camera.rayDirection(x + (sx + 0.5) / samples, y + (sy + 0.5) / samples);
+        return screenDirection(camera, columnX[static_cast<std::size_t>((x - x0) * samples + sx)],
+                               rowY[static_cast<std::size_t>((y - y0) * samples + sy)]);
     };
     // The cone pre-pass: one cone around each block of kConeBlock^2 pixels finds how far all
     // their rays may go before they can come near the set.
@@ -894,10 +918,7 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
 }  // namespace
 
 glm::dvec3 CameraFrame::rayDirection(double px, double py) const {
-    const double aspect = static_cast<double>(width) / height;
-    const double x = (2.0 * px / width - 1.0) * tanHalfFov * aspect;
-    const double y = (1.0 - 2.0 * py / height) * tanHalfFov;  // image rows go down, `up` goes up
-    return glm::normalize(forward + x * right + y * up);
+    return screenDirection(*this, screenX(*this, px), screenY(*this, py));
 }
 
 CameraFrame frameCamera(const Params& params, const Bounds& bounds) {
