@@ -336,7 +336,10 @@ public:
     }
 
     /// Takes the escapes of the points the last queries() named, in order, and moves on.
-    void answer(const Probe* escapes) {
+    /// `escapes[i]`: the Probe of the i-th point (a Probe array, or a view of the batch kernel's
+    /// results read in place).
+    template <class Escapes>
+    void answer(const Escapes& escapes) {
         switch (stage_) {
             case Stage::March: answerMarch(escapes[0]); return;
             case Stage::Bisect: answerBisect(escapes[0]); return;
@@ -463,7 +466,8 @@ private:
 
     /// Central differences of the DE; where one side is inside (DE clamped to 0, not negative) a
     /// one-sided difference from the hit point avoids bending the normal.
-    void answerNormal(const Probe* probes) {
+    template <class Escapes>
+    void answerNormal(const Escapes& probes) {
         const double here = scene_->distance3(trace_.escape);
         glm::dvec3 gradient(0.0);
         for (int axis = 0; axis < 3; ++axis) {
@@ -508,7 +512,8 @@ private:
     /// Ambient occlusion, 1 = open, 0 = fully occluded. Compares the DE at probes along the
     /// normal with their height above the surface; the DE is about half the true distance
     /// (exactly half for the ball, c = 0), so 2 * DE is the estimate of the free distance.
-    void answerOcclusion(const Probe* probes) {
+    template <class Escapes>
+    void answerOcclusion(const Escapes& probes) {
         double sum = 0.0;
         double weight = 0.5;
         double totalWeight = 0.0;
@@ -546,13 +551,15 @@ private:
         }
     }
 
-    void answerShadows(const Probe* escapes) {
+    template <class Escapes>
+    void answerShadows(const Escapes& escapes) {
         const Scene& scene = *scene_;
         bool marching = false;
+        std::size_t next = 0;  // the next escape: one per march still going, in light order
         for (std::size_t index = 0; index < scene.lights_.size(); ++index) {
             ShadowMarch& shadow = shadows_[index];
             if (shadow.done) continue;
-            const Probe& escape = *escapes++;
+            const Probe& escape = escapes[next++];
             double d = escape.de / scene.stretch_;
             if (!std::isfinite(d)) d = scene.settings_.maxStep;
             const bool blocked = escape.n == 0 || d < 0.25 * hitEps_;
@@ -671,7 +678,7 @@ public:
             std::size_t kept = 0;
             for (std::size_t k = 0; k < active_.size(); ++k) {
                 RayJob& job = jobs[active_[k]];
-                job.answer(probes_.data() + offset);
+                job.answer(BatchEscapes{&batch_, offset});
                 offset += counts_[k];
                 if (job.done()) continue;
                 active_[kept] = active_[k];
@@ -684,7 +691,7 @@ public:
     }
 
 private:
-    /// points_ -> probes_ through the SIMD kernel. The 8-D coordinates are Slice::map's
+    /// points_ -> batch_'s results through the SIMD kernel. The 8-D coordinates are Slice::map's
     /// expression, coordinate by coordinate, so they round the same; terms with a zero axis
     /// component are left out (they add a zero, which changes at most the sign of a zero).
     void evaluateBatch(const Scene& scene) {
@@ -735,14 +742,21 @@ private:
             }
         }
         batch_.evaluate(scene.fractal());
-        probes_.resize(count);
-        for (std::size_t i = 0; i < count; ++i)
-            probes_[i] = {batch_.n(i), batch_.r(i), batch_.ra(i), batch_.rb(i), batch_.de(i), batch_.trap(i)};
     }
+
+    /// The kernel's results from `first` on, read in place as Probes (RayJob::answer).
+    struct BatchEscapes {
+        const BatchBuffer<double>* batch;
+        std::size_t first;
+        Probe operator[](std::size_t i) const {
+            const std::size_t j = first + i;
+            return {batch->n(j), batch->r(j), batch->ra(j), batch->rb(j), batch->de(j), batch->trap(j)};
+        }
+    };
 
     std::vector<glm::dvec3> points_;
     std::vector<glm::dvec3> nextPoints_;  // the next round's, filled while answering this one
-    std::vector<Probe> probes_;
+    std::vector<Probe> probes_;           // the scalar engine's escapes
     std::vector<std::size_t> counts_;
     std::vector<std::size_t> active_;
     BatchBuffer<double> batch_;
