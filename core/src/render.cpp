@@ -774,6 +774,18 @@ struct TileStats {
     std::uint64_t evaluations = 0;
 };
 
+/// A thread's buffers for its tiles, kept from tile to tile (no allocation once they have
+/// grown): all in one thread_local.
+struct TileBuffers {
+    Evaluator evaluator;
+    std::vector<RayJob> jobs;
+    std::vector<ShadowMarch> shadowSlots;  // the jobs' shadow marches (RayJob's `shadows`)
+    std::vector<double> columnX;           // image plane x of the tile's sub-pixel columns
+    std::vector<double> rowY;              // and y of its rows
+    std::vector<double> starts;            // per cone block: where its rays start (+inf: all miss)
+    std::vector<std::size_t> firstJob;     // per pixel of the pass: its first job, or kNoJob
+};
+
 TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, int x1, int y1, Image& image) {
     TileStats stats;
     const CameraFrame& camera = scene.camera();
@@ -784,16 +796,17 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
     const int pixels = width * (y1 - y0);
     // The tile's pixels go through in passes of about kRaysPerPass rays, whole pixels at a time.
     const int pixelsPerPass = std::max(1, kRaysPerPass / perPixel);
-    thread_local Evaluator evaluator;
-    thread_local std::vector<RayJob> jobs;
+    thread_local TileBuffers buffers;
+    Evaluator& evaluator = buffers.evaluator;
+    std::vector<RayJob>& jobs = buffers.jobs;
     // Room for the shadow marches of a pass's rays: job k has the lights' slots from k * lights.
-    thread_local std::vector<ShadowMarch> shadowSlots;
+    std::vector<ShadowMarch>& shadowSlots = buffers.shadowSlots;
     const std::size_t lights = scene.lightCount();
     shadowSlots.resize(std::max(shadowSlots.size(), static_cast<std::size_t>(pixelsPerPass) * perPixel * lights));
     // A regular grid of sub-pixel positions; with one sample, the pixel centre. Their image
     // plane coordinates, per sub-pixel column and row of the tile, are worked out once.
-    thread_local std::vector<double> columnX;
-    thread_local std::vector<double> rowY;
+    std::vector<double>& columnX = buffers.columnX;
+    std::vector<double>& rowY = buffers.rowY;
     columnX.clear();
     rowY.clear();
     for (int x = x0; x < x1; ++x)
@@ -829,8 +842,8 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
         }
     }
     evaluator.run(scene, engine, jobs);
-    thread_local std::vector<double> starts;
-    thread_local std::vector<std::size_t> firstJob;  // per pixel of the pass: its first job, or kNoJob
+    std::vector<double>& starts = buffers.starts;
+    std::vector<std::size_t>& firstJob = buffers.firstJob;
     constexpr std::size_t kNoJob = std::numeric_limits<std::size_t>::max();
     starts.clear();
     for (const RayJob& job : jobs) starts.push_back(job.coneStart());
