@@ -814,8 +814,9 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
     for (int y = y0; y < y1; ++y)
         for (int sy = 0; sy < samples; ++sy) rowY.push_back(screenY(camera, y + (sy + 0.5) / samples));
     auto sampleDirection = [&](int x, int y, int sx, int sy) {
-        return screenDirection(camera, columnX[static_cast<std::size_t>((x - x0) * samples + sx)],
-                               rowY[static_cast<std::size_t>((y - y0) * samples + sy)]);
+        const int column = (x - x0) * samples + sx;
+        const int row = (y - y0) * samples + sy;
+        return screenDirection(camera, columnX[static_cast<std::size_t>(column)], rowY[static_cast<std::size_t>(row)]);
     };
     // The cone pre-pass: one cone around each block of kConeBlock^2 pixels finds how far all
     // their rays may go before they can come near the set.
