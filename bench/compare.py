@@ -5,7 +5,12 @@ Measures, in one run on this machine, and prints a table of ratios:
   1. render: a 640x480 image of the quaternion Julia set c = (-0.39054, -0.58679, 0, 0), N = 12,
      by `dqjulia render` (variant dual, zero dual constant) against POV-Ray's built-in
      julia_fractal with the same constant, bailout, camera, lights and size; wall-clock and CPU
-     time, a silhouette overlap check (IoU) and a speckle measure for each picture;
+     time, a silhouette overlap check (IoU) and a speckle measure for each picture. Twice: in
+     POV-Ray's look (one ray a pixel, no occlusion) and each program on its defaults (dqjulia's
+     2x2 samples, occlusion and soft shadows against POV-Ray's default quality, no
+     anti-aliasing); then POV-Ray's look again on a second set, c = (-0.55, 0.1, 0.45, 0), N = 10
+     (j component nonzero, k still 0, so POV-Ray's k = 0 slice is the same set). With
+     --baseline, another dqjulia binary (an older build) is timed in the same interleaved runs;
   2. mesh at 256^3 and 512^3 by `dqjulia mesh` against Mandelbulber 2's marching-cubes PLY export
      (`mandelbulber2 -n -V ply`) of the same set and box; time and peak memory;
   3. bake (`dqjulia bake`, an OpenVDB level set) at 256^3, 512^3, 1024^3 and 2048^3, and the
@@ -23,6 +28,7 @@ not the escape set, so its surface sits slightly outside ours.
 
 Usage: bench/compare.py [--build DIR] [--repeat N] [--skip-mesh] [--skip-bake] [--skip-kernel]
                         [--mesh-resolutions 256,512] [--bake-resolutions 256,512,1024,2048] [--keep DIR]
+                        [--baseline DQJULIA]
 Installs povray and mandelbulber2 with apt-get if they are missing (needs root). Times are
 medians of --repeat runs (default 3), the programs interleaved, so both see the same machine
 load; peak memory is the largest resident set (/usr/bin/time -v). The machine may be busy with
@@ -51,9 +57,16 @@ MAGENTA = (255, 0, 255)  # flat background of both renders, so silhouettes can b
 LIGHTS = [((0.6, 0.8, 0.7), (1.0, 0.96, 0.9)), ((-0.7, 0.2, -0.5), (0.55 * 0.35, 0.65 * 0.35, 0.9 * 0.35))]
 
 
-def bailout():
+# The render scenes: the bench's set, and a second one of this file's own choice (j nonzero, k 0).
+SCENES = [
+    {"name": "bench", "c": C, "n": N},
+    {"name": "second", "c": (-0.55, 0.1, 0.45, 0.0), "n": 10},
+]
+
+
+def bailout(c=C):
     """POV-Ray's julia_fractal bailout for quaternion sqr: min(1 + |c|, 2) (plus 1e-7)."""
-    return min(1.0 + math.sqrt(sum(x * x for x in C)), 2.0)
+    return min(1.0 + math.sqrt(sum(x * x for x in c)), 2.0)
 
 
 # ---------------------------------------------------------------- running and measuring
@@ -184,7 +197,7 @@ def speckle(rows, mask):
 # ---------------------------------------------------------------- the three programs
 
 
-def povray_scene(path, max_iteration):
+def povray_scene(path, max_iteration, c=C):
     aspect = WIDTH / HEIGHT
     horizontal = 2.0 * math.degrees(math.atan(math.tan(math.radians(FOV / 2)) * aspect))
     lights = "\n".join(
@@ -198,15 +211,17 @@ camera {{ perspective location <{EYE[0]}, {EYE[1]}, {EYE[2]}> look_at <{TARGET[0
          right -x*{aspect} up y angle {horizontal} }}
 background {{ rgb <1, 0, 1> }}
 {lights}
-julia_fractal {{ <{C[0]}, {C[1]}, {C[2]}, {C[3]}> quaternion sqr max_iteration {max_iteration} precision 20
+julia_fractal {{ <{c[0]}, {c[1]}, {c[2]}, {c[3]}> quaternion sqr max_iteration {max_iteration} precision 20
   pigment {{ rgb <0.85, 0.62, 0.35> }} finish {{ ambient 0.15 diffuse 0.8 specular 0.35 }} }}
 """)
 
 
-def dqjulia_params(path):
+def dqjulia_params(path, c=C, n=N, defaults=False):
+    """The scene in POV-Ray's look; with `defaults`, dqjulia's own material and quality (2x2
+    samples, occlusion, soft shadows), only the background flat magenta for the silhouette."""
     import json
     params = {
-        "fractal": {"c": list(C) + [0, 0, 0, 0], "variant": "dual", "iterations": N, "bailout": bailout()},
+        "fractal": {"c": list(c) + [0, 0, 0, 0], "variant": "dual", "iterations": n, "bailout": bailout(c)},
         "camera": {"position": list(EYE), "target": list(TARGET), "fov": FOV},
         "lights": [{"direction": list(d), "color": list(c), "intensity": 1.0} for d, c in LIGHTS],
         # The POV-Ray scene's look: one colour, Phong, shadows, no ambient occlusion.
@@ -214,6 +229,9 @@ def dqjulia_params(path):
                      "specular": 0.35, "occlusion": 0, "shadows": True},
         "render": {"width": WIDTH, "height": HEIGHT, "samples": 1, "background": [1, 0, 1]},
     }
+    if defaults:
+        del params["material"]
+        params["render"] = {"width": WIDTH, "height": HEIGHT, "background": [1, 0, 1]}
     with open(path, "w") as out:
         json.dump(params, out, indent=2)
 
@@ -308,6 +326,7 @@ def main():
     parser.add_argument("--mesh-resolutions", default="256,512")
     parser.add_argument("--bake-resolutions", default="256,512,1024,2048")
     parser.add_argument("--keep", help="keep the images and meshes in this folder")
+    parser.add_argument("--baseline", help="another dqjulia binary to time in the same runs (before/after)")
     args = parser.parse_args()
 
     args.build = os.path.abspath(args.build)  # the programs run in the work folder
@@ -323,6 +342,48 @@ def main():
             shutil.rmtree(work, ignore_errors=True)
 
 
+def render_rows(args, dqjulia, work, rows, label, case, defaults):
+    """Times one render against POV-Ray's (and the --baseline binary's) and appends the rows."""
+    tag = case["name"] + ("_defaults" if defaults else "")
+    params = os.path.join(work, f"render_{tag}.json")
+    dqjulia_params(params, case["c"], case["n"], defaults)
+    scene = os.path.join(work, f"julia_{case['name']}.pov")
+    povray_scene(scene, case["n"] + 1, case["c"])
+    ours_png = os.path.join(work, f"dqjulia_{tag}.png")
+    pov_png = os.path.join(work, f"povray_{case['name']}.png")
+    commands = {
+        "dqjulia": [dqjulia, "render", "-q", "-f", "-p", params, "-o", ours_png],
+        "povray": ["povray", f"+I{scene}", f"+O{pov_png}", f"+W{WIDTH}", f"+H{HEIGHT}", "-D", "-V", "+FN", "-GA"],
+    }
+    if args.baseline:
+        commands["baseline"] = [args.baseline, "render", "-q", "-f", "-p", params, "-o",
+                                os.path.join(work, f"baseline_{tag}.png")]
+    times = median_runs(commands, args.repeat, cwd=work, warm_up=True)
+    _, _, ours_rows = read_png(ours_png)
+    _, _, pov_rows = read_png(pov_png)
+    ours_mask, pov_mask = silhouette(ours_rows), silhouette(pov_rows)
+    overlap = iou(ours_mask, pov_mask)
+    ours_speckle, pov_speckle = speckle(ours_rows, ours_mask), speckle(pov_rows, pov_mask)
+    wall_ratio = times["povray"]["wall"] / times["dqjulia"]["wall"]
+    cpu_ratio = times["povray"]["cpu"] / times["dqjulia"]["cpu"]
+    goal = 5.0 if defaults else 10.0
+    rows.append((f"render{label} 640x480 wall s", f"{times['dqjulia']['wall']:.3f}",
+                 f"POV-Ray {times['povray']['wall']:.3f}", f"{wall_ratio:.2f}x faster", f">= {goal:g}x",
+                 wall_ratio >= goal))
+    rows.append((f"render{label} 640x480 CPU s", f"{times['dqjulia']['cpu']:.3f}", f"POV-Ray {times['povray']['cpu']:.3f}",
+                 f"{cpu_ratio:.2f}x less CPU", "", None))
+    if args.baseline:
+        before = times["baseline"]["wall"] / times["dqjulia"]["wall"]
+        before_cpu = times["baseline"]["cpu"] / times["dqjulia"]["cpu"]
+        rows.append((f"render{label} vs --baseline wall s", f"{times['dqjulia']['wall']:.3f}",
+                     f"baseline {times['baseline']['wall']:.3f}", f"{before:.2f}x faster (CPU {before_cpu:.2f}x)", "",
+                     None))
+    rows.append((f"render{label} silhouette IoU", f"{overlap:.4f}", "", "same object" if overlap > 0.9 else "DIFFERENT",
+                 "> 0.9", overlap > 0.9))
+    rows.append((f"render{label} speckle (object px)", f"{100 * ours_speckle:.3f}%", f"POV-Ray {100 * pov_speckle:.3f}%",
+                 "cleaner" if ours_speckle < pov_speckle else "NOT cleaner", "cleaner", ours_speckle < pov_speckle))
+
+
 def compare(args, dqjulia, work):
     """Runs the measurements in the folder `work` and prints the table."""
     params = os.path.join(work, "quaternion_julia.json")
@@ -330,32 +391,12 @@ def compare(args, dqjulia, work):
     rows = []  # (measure, dqjulia, other, ratio text, target, met)
     print(f"c = {C}, N = {N}, R = {bailout():.6f}, {WIDTH}x{HEIGHT}; working in {work}", flush=True)
 
-    # 1. Render against POV-Ray.
+    # 1. Render against POV-Ray: the bench scene in POV-Ray's look, each program on its
+    # defaults, then the second scene in POV-Ray's look.
     if ensure_installed("povray", "povray"):
-        scene = os.path.join(work, "julia.pov")
-        povray_scene(scene, N + 1)
-        ours_png = os.path.join(work, "dqjulia.png")
-        pov_png = os.path.join(work, "povray.png")
-        commands = {
-            "dqjulia": [dqjulia, "render", "-q", "-f", "-p", params, "-o", ours_png],
-            "povray": ["povray", f"+I{scene}", f"+O{pov_png}", f"+W{WIDTH}", f"+H{HEIGHT}", "-D", "-V", "+FN", "-GA"],
-        }
-        times = median_runs(commands, args.repeat, cwd=work, warm_up=True)
-        _, _, ours_rows = read_png(ours_png)
-        _, _, pov_rows = read_png(pov_png)
-        ours_mask, pov_mask = silhouette(ours_rows), silhouette(pov_rows)
-        overlap = iou(ours_mask, pov_mask)
-        ours_speckle, pov_speckle = speckle(ours_rows, ours_mask), speckle(pov_rows, pov_mask)
-        wall_ratio = times["povray"]["wall"] / times["dqjulia"]["wall"]
-        cpu_ratio = times["povray"]["cpu"] / times["dqjulia"]["cpu"]
-        rows.append(("render 640x480 wall s", f"{times['dqjulia']['wall']:.3f}", f"POV-Ray {times['povray']['wall']:.3f}",
-                     f"{wall_ratio:.2f}x faster", ">= 5x", wall_ratio >= 5.0))
-        rows.append(("render 640x480 CPU s", f"{times['dqjulia']['cpu']:.3f}", f"POV-Ray {times['povray']['cpu']:.3f}",
-                     f"{cpu_ratio:.2f}x less CPU", "", None))
-        rows.append(("render silhouette IoU", f"{overlap:.4f}", "", "same object" if overlap > 0.9 else "DIFFERENT",
-                     "> 0.9", overlap > 0.9))
-        rows.append(("render speckle (object px)", f"{100 * ours_speckle:.3f}%", f"POV-Ray {100 * pov_speckle:.3f}%",
-                     "cleaner" if ours_speckle < pov_speckle else "NOT cleaner", "cleaner", ours_speckle < pov_speckle))
+        cases = [("", SCENES[0], False), (" defaults", SCENES[0], True), (f" {SCENES[1]['name']}", SCENES[1], False)]
+        for label, case, defaults in cases:
+            render_rows(args, dqjulia, work, rows, label, case, defaults)
 
     # 2. Mesh against Mandelbulber 2.
     if not args.skip_mesh:
@@ -448,6 +489,11 @@ def compare(args, dqjulia, work):
                 double_ratio, float_ratio = float(parts[3]), float(parts[5])
                 rows.append((f"kernel {parts[0]} SIMD/scalar", f"double {double_ratio:.2f}x", f"float {float_ratio:.2f}x",
                              "", ">= 4x", max(double_ratio, float_ratio) >= 4.0))
+            if parts and parts[0] in ("paper", "paper-coupled", "dual") and len(parts) >= 10:
+                # Share of one core's peak FLOP rate (kernel_bench.cpp: lanes x 2 FMA x 2 flops x clock).
+                double_share, float_share = float(parts[8].rstrip("%")), float(parts[9].rstrip("%"))
+                rows.append((f"kernel {parts[0]} share of peak", f"double {double_share:.1f}%", f"float {float_share:.1f}%",
+                             "", ">= 35% / >= 50%", double_share >= 35.0 and float_share >= 50.0))
 
     width = [max(len(str(row[i])) for row in rows + [("measure", "dqjulia", "other", "ratio", "target", "")]) for i in range(5)]
     print()

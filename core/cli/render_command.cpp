@@ -103,8 +103,10 @@ int runRender(const RenderOptions& options) {
                   << stats.seconds << " s)\n";
     if (options.stats)
         std::cout << "rays " << stats.rays << "\nsteps " << stats.steps << "\nsteps_per_ray "
-                  << (stats.rays ? double(stats.steps) / double(stats.rays) : 0.0) << "\nhit_pixels " << stats.hitPixels
-                  << "\nseconds " << stats.seconds << "\n";
+                  << (stats.rays ? double(stats.steps) / double(stats.rays) : 0.0) << "\nevaluations "
+                  << stats.evaluations << "\nevaluations_per_ray "
+                  << (stats.rays ? double(stats.evaluations) / double(stats.rays) : 0.0) << "\nhit_pixels "
+                  << stats.hitPixels << "\nseconds " << stats.seconds << "\n";
     return kSuccess;
 }
 

@@ -14,11 +14,15 @@
 #include "dqjulia/inspect.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 #include <glm/geometric.hpp>
@@ -33,9 +37,16 @@ constexpr double kInfinity = std::numeric_limits<double>::infinity();
 constexpr int kTileSize = 16;
 constexpr int kOcclusionSamples = 5;
 constexpr int kShadowSteps = 64;    // soft shadows are a look, not a measurement: cap their cost
+/// Shadow marches step by this many DEs (over-relaxed; the DE is about half the distance) and
+/// fall back to the plain step where two consecutive free balls do not overlap.
+constexpr double kShadowRelaxation = 1.6;
 constexpr int kBisectionSteps = 8;  // refines a step that landed inside to 1/256 of the step
 constexpr double kFootprintFloor = 1e-7;
 constexpr int kRaysPerPass = 1024;  // rays traced together: whole pixels of a tile
+constexpr int kConeBlock = 4;       // pixels per side of the blocks a cone pre-pass marches for
+/// A cone stops where its free margin (DE minus its radius) drops below this many hit
+/// thresholds: its rays then start well before any point where they could stop.
+constexpr double kConeMargin = 4.0;
 
 /// The normal turned towards the eye. A gradient that tips past perpendicular to the ray (a
 /// surface seen edge on, where the differences straddle a crease) is bent back onto the
@@ -47,6 +58,20 @@ glm::dvec3 facingRay(const glm::dvec3& normal, const glm::dvec3& direction) {
     const glm::dvec3 bent = normal - along * direction;
     const double length = glm::length(bent);
     return length > 1e-6 ? bent / length : -direction;
+}
+
+/// CameraFrame::rayDirection in parts: the image plane's x of a pixel column, its y of a row,
+/// and the direction through (x, y). A tile works its columns and rows out once; the same
+/// expressions give the same directions, bit for bit.
+double screenX(const CameraFrame& camera, double px) {
+    const double aspect = static_cast<double>(camera.width) / camera.height;
+    return (2.0 * px / camera.width - 1.0) * camera.tanHalfFov * aspect;
+}
+double screenY(const CameraFrame& camera, double py) {
+    return (1.0 - 2.0 * py / camera.height) * camera.tanHalfFov;  // image rows go down, `up` goes up
+}
+glm::dvec3 screenDirection(const CameraFrame& camera, double x, double y) {
+    return glm::normalize(camera.forward + x * camera.right + y * camera.up);
 }
 
 /// Where a ray meets a sphere: [near, far] along the ray, or nothing.
@@ -133,7 +158,9 @@ public:
     }
 
     const CameraFrame& camera() const { return camera_; }
+    const Bounds& bounds() const { return bounds_; }
     int samples() const { return samples_; }
+    std::size_t lightCount() const { return lights_.size(); }
 
     /// Hit threshold at distance t from the eye: `detail` pixel footprints.
     double epsilon(double t) const { return std::max(settings_.detail * t * footprint_, kFootprintFloor); }
@@ -183,6 +210,24 @@ private:
     double occlusionDelta_ = 0.02;
 };
 
+/// A soft-shadow march towards one directional light: 0 = blocked, 1 = lit; penumbra from
+/// the closest miss along the way (k * d / t). It starts from its ray's shadow origin and goes
+/// along the light's direction (both the same for every light of a ray: not stored here).
+struct ShadowMarch {
+    double far = 0.0;
+    double t = 0.0;
+    double result = 1.0;
+    double lit = 1.0;
+    // Over-relaxation: the last point marched from, its DE and plain step, and whether the
+    // step from it was the long one (checked when its point is answered).
+    double previousT = 0.0;
+    double previousD = 0.0;
+    double plainStep = 0.0;
+    int step = 0;
+    bool done = true;
+    bool relaxed = false;
+};
+
 /// One camera ray, from the eye to its shaded colour, as a state machine. Each stage names the
 /// 3-D points whose escape it needs next (queries()) and moves on when given their escapes
 /// (answer()): sphere tracing, bisecting back to the surface, the normal's probes (central
@@ -193,17 +238,64 @@ private:
 /// logarithm.
 class RayJob {
 public:
-    RayJob(const Scene& scene, const glm::dvec3& direction) : scene_(&scene), direction_(direction) {
+    /// A camera ray; `start`: where a cone pre-pass proved the way free (0: from the bounds).
+    /// `shadows`: room for one shadow march per light of the scene, owned by the caller (a pool
+    /// reused from pass to pass: no allocation per ray).
+    RayJob(const Scene& scene, const glm::dvec3& direction, double start, ShadowMarch* shadows)
+        : scene_(&scene), direction_(direction), shadows_(shadows) {
         span_ = intersectSphere(scene.camera_.eye, direction, scene.bounds_);
-        if (!span_.valid || scene.empty_) {
+        if (!span_.valid || scene.empty_ || start > span_.far) {
             finishMarch();
             return;
         }
-        t_ = previousT_ = span_.near;
+        seeded_ = start > span_.near;
+        t_ = previousT_ = std::max(span_.near, start);
         stage_ = Stage::March;
     }
 
-    bool done() const { return stage_ == Stage::Done; }
+    /// A cone pre-pass: marches the cone of half-width `spread` * t around `axis` over
+    /// [near, far] (its rays' spans) and stops where the set may come within reach of one of
+    /// its rays; coneStart() is then where those rays may start marching (+inf: all miss).
+    static RayJob cone(const Scene& scene, const glm::dvec3& axis, double spread, double near, double far) {
+        RayJob job(scene, axis, kInfinity, nullptr);  // a miss: no stage yet; no shading
+        job.cone_ = true;
+        job.spread_ = spread;
+        job.span_ = {true, near, far};
+        job.t_ = near;
+        job.coneStart_ = near;
+        job.stage_ = scene.empty_ || !(near <= far) || !std::isfinite(near) ? Stage::Done : Stage::March;
+        return job;
+    }
+    double coneStart() const { return coneStart_; }
+
+    /// No more queries: finished, or paused before its shading (pausesBeforeShading()).
+    bool done() const { return stage_ == Stage::Done || stage_ == Stage::Paused; }
+    bool paused() const { return stage_ == Stage::Paused; }
+
+    /// Goes on from the pause to its own occlusion and shadows.
+    void resumeShading() {
+        if (stage_ == Stage::Paused) beginShading();
+    }
+
+    /// Whether this paused sample may take the occlusion and shadows of `other`, a sample of the
+    /// same pixel shaded already: both on one piece of surface (hit points within two hit
+    /// thresholds, normals within 18 degrees) facing the same lights.
+    bool canShareShading(const RayJob& other) const {
+        if (!paused() || other.stage_ != Stage::Done || !other.trace_.hit) return false;
+        const double reach = 2.0 * std::max(hitEps_, other.hitEps_);
+        if (glm::length(p_ - other.p_) > reach || glm::dot(normal_, other.normal_) < 0.95) return false;
+        for (const auto& light : scene_->lights_)
+            if ((glm::dot(normal_, light.direction) > 0.0) != (glm::dot(other.normal_, light.direction) > 0.0))
+                return false;
+        return true;
+    }
+
+    /// Shades this paused sample with the occlusion and shadows of `other` (canShareShading()).
+    void shareShading(const RayJob& other) {
+        open_ = other.open_;
+        std::copy(other.shadows_, other.shadows_ + scene_->lights_.size(), shadows_);
+        finishShading();
+    }
     const Trace& trace() const { return trace_; }
     /// The shaded colour for a hit, the background for a miss.
     const glm::dvec3& colour() const { return colour_; }
@@ -229,49 +321,47 @@ public:
                 return kOcclusionSamples;
             case Stage::Shadows: {
                 std::size_t count = 0;
-                for (const ShadowMarch& shadow : shadows_) {
+                const std::size_t lights = scene_->lights_.size();
+                for (std::size_t index = 0; index < lights; ++index) {
+                    const ShadowMarch& shadow = shadows_[index];
                     if (shadow.done) continue;
-                    points.push_back(shadow.origin + shadow.t * shadow.toLight);
+                    points.push_back(shadowOrigin_ + shadow.t * scene_->lights_[index].direction);
                     ++count;
                 }
                 return count;
             }
+            case Stage::Paused:
             case Stage::Done: return 0;
         }
         return 0;
     }
 
     /// Takes the escapes of the points the last queries() named, in order, and moves on.
-    void answer(const Probe* escapes) {
+    /// `escapes[i]`: the Probe of the i-th point (a Probe array, or a view of the batch kernel's
+    /// results read in place).
+    template <class Escapes>
+    void answer(const Escapes& escapes) {
         switch (stage_) {
             case Stage::March: answerMarch(escapes[0]); return;
             case Stage::Bisect: answerBisect(escapes[0]); return;
             case Stage::Normal: answerNormal(escapes); return;
             case Stage::Occlusion: answerOcclusion(escapes); return;
             case Stage::Shadows: answerShadows(escapes); return;
+            case Stage::Paused:
             case Stage::Done: return;
         }
     }
 
 private:
-    enum class Stage { March, Bisect, Normal, Occlusion, Shadows, Done };
-
-    /// A soft-shadow march towards one directional light: 0 = blocked, 1 = lit; penumbra from
-    /// the closest miss along the way (k * d / t).
-    struct ShadowMarch {
-        glm::dvec3 origin{0.0};
-        glm::dvec3 toLight{0.0};
-        double far = 0.0;
-        double t = 0.0;
-        double result = 1.0;
-        int step = 0;
-        bool done = true;
-        double lit = 1.0;
-    };
+    enum class Stage { March, Bisect, Normal, Occlusion, Shadows, Paused, Done };
 
     /// Sphere tracing: step by stepFactor * min(DE / stretch, maxStep) until the DE is below
     /// the hit threshold or the ray leaves the bounds.
     void answerMarch(const Probe& escape) {
+        if (cone_) {
+            answerCone(escape);
+            return;
+        }
         const RenderSettings& settings = scene_->settings_;
         ++trace_.steps;
         eps_ = scene_->epsilon(t_);
@@ -280,7 +370,7 @@ private:
             if (!havePrevious_) {
                 trace_.t = t_;
                 trace_.escape = escape;
-                trace_.cutFace = step_ == 0 && scene_->bounds_.clipped && span_.near > 0.0;
+                trace_.cutFace = step_ == 0 && !seeded_ && scene_->bounds_.clipped && span_.near > 0.0;
                 finishMarch();
                 return;
             }
@@ -316,6 +406,26 @@ private:
                 trace_.escape = previous_;
             }
             finishMarch();
+        }
+    }
+
+    /// Cone marching (the pre-pass): every ray of the cone lies within spread * t of the axis,
+    /// so the ball of radius DE around the axis point keeps it free for a step of
+    /// (DE - spread * t) / (1 + spread), with the rays' step factor and largest step.
+    void answerCone(const Probe& escape) {
+        const RenderSettings& settings = scene_->settings_;
+        double free = scene_->distance3(escape);
+        if (!std::isfinite(free)) free = settings.maxStep;  // zero derivative: as the rays do
+        free -= spread_ * t_;
+        coneStart_ = t_;
+        if (escape.n == 0 || free < kConeMargin * scene_->epsilon(t_) || ++step_ == settings.maxSteps) {
+            stage_ = Stage::Done;
+            return;
+        }
+        t_ += settings.stepFactor * std::min(free / (1.0 + spread_), settings.maxStep);
+        if (t_ > span_.far) {
+            coneStart_ = kInfinity;  // the cone leaves the bounds: every ray of it misses
+            stage_ = Stage::Done;
         }
     }
 
@@ -357,7 +467,8 @@ private:
 
     /// Central differences of the DE; where one side is inside (DE clamped to 0, not negative) a
     /// one-sided difference from the hit point avoids bending the normal.
-    void answerNormal(const Probe* probes) {
+    template <class Escapes>
+    void answerNormal(const Escapes& probes) {
         const double here = scene_->distance3(trace_.escape);
         glm::dvec3 gradient(0.0);
         for (int axis = 0; axis < 3; ++axis) {
@@ -380,6 +491,17 @@ private:
         const double length = glm::length(gradient);
         normal_ = length > 0.0 && std::isfinite(length) ? gradient / length : -direction_;
         normal_ = facingRay(normal_, direction_);
+        // With several samples a pixel, one of them shades first and the others may share its
+        // occlusion and shadows (renderTile): they wait here.
+        const Material& material = scene_->material_;
+        if (scene_->samples_ > 1 && (material.occlusion > 0.0 || material.shadows) && !scene_->lights_.empty()) {
+            stage_ = Stage::Paused;
+            return;
+        }
+        beginShading();
+    }
+
+    void beginShading() {
         if (scene_->material_.occlusion > 0.0) {
             stage_ = Stage::Occlusion;
         } else {
@@ -391,7 +513,8 @@ private:
     /// Ambient occlusion, 1 = open, 0 = fully occluded. Compares the DE at probes along the
     /// normal with their height above the surface; the DE is about half the true distance
     /// (exactly half for the ball, c = 0), so 2 * DE is the estimate of the free distance.
-    void answerOcclusion(const Probe* probes) {
+    template <class Escapes>
+    void answerOcclusion(const Escapes& probes) {
         double sum = 0.0;
         double weight = 0.5;
         double totalWeight = 0.0;
@@ -408,15 +531,14 @@ private:
     /// One shadow march for every light the surface faces (when shadows are on).
     void startShadows() {
         const Scene& scene = *scene_;
-        shadows_.assign(scene.lights_.size(), ShadowMarch{});
+        std::fill(shadows_, shadows_ + scene.lights_.size(), ShadowMarch{});
+        shadowOrigin_ = p_ + normal_ * (2.0 * hitEps_);
         bool marching = false;
         for (std::size_t index = 0; index < scene.lights_.size(); ++index) {
             const glm::dvec3& toLight = scene.lights_[index].direction;
             if (!scene.material_.shadows || glm::dot(normal_, toLight) <= 0.0) continue;
             ShadowMarch& shadow = shadows_[index];
-            shadow.origin = p_ + normal_ * (2.0 * hitEps_);
-            shadow.toLight = toLight;
-            const Interval span = intersectSphere(shadow.origin, toLight, scene.bounds_);
+            const Interval span = intersectSphere(shadowOrigin_, toLight, scene.bounds_);
             if (!span.valid) continue;
             shadow.far = span.far;
             shadow.t = 2.0 * hitEps_;
@@ -430,20 +552,36 @@ private:
         }
     }
 
-    void answerShadows(const Probe* escapes) {
+    template <class Escapes>
+    void answerShadows(const Escapes& escapes) {
         const Scene& scene = *scene_;
         bool marching = false;
-        for (ShadowMarch& shadow : shadows_) {
+        std::size_t next = 0;  // the next escape: one per march still going, in light order
+        for (std::size_t index = 0; index < scene.lights_.size(); ++index) {
+            ShadowMarch& shadow = shadows_[index];
             if (shadow.done) continue;
-            const Probe& escape = *escapes++;
+            const Probe& escape = escapes[next++];
             double d = escape.de / scene.stretch_;
             if (!std::isfinite(d)) d = scene.settings_.maxStep;
-            if (escape.n == 0 || d < 0.25 * hitEps_) {
+            const bool blocked = escape.n == 0 || d < 0.25 * hitEps_;
+            if (shadow.relaxed && (blocked || shadow.t - shadow.previousT > shadow.previousD + d)) {
+                // The long step may have passed an occluder (its free ball and the last one do
+                // not overlap, or it landed on the set): take the plain step from the last point.
+                shadow.t = shadow.previousT + shadow.plainStep;
+                shadow.relaxed = false;
+                shadow.done = !(++shadow.step < kShadowSteps && shadow.t < shadow.far);
+            } else if (blocked) {
                 shadow.result = 0.0;
                 shadow.done = true;
             } else {
                 shadow.result = std::min(shadow.result, scene.material_.shadowSoftness * d / shadow.t);
-                shadow.t += std::clamp(scene.settings_.stepFactor * d, hitEps_, scene.settings_.maxStep);
+                const double plain = std::clamp(scene.settings_.stepFactor * d, hitEps_, scene.settings_.maxStep);
+                const double relaxed = std::clamp(kShadowRelaxation * d, hitEps_, scene.settings_.maxStep);
+                shadow.previousT = shadow.t;
+                shadow.previousD = d;
+                shadow.plainStep = plain;
+                shadow.relaxed = relaxed > plain && shadow.t + relaxed < shadow.far;
+                shadow.t += shadow.relaxed ? relaxed : plain;
                 shadow.done = !(++shadow.step < kShadowSteps && shadow.t < shadow.far);
             }
             if (shadow.done) shadow.lit = std::clamp(shadow.result, 0.0, 1.0);
@@ -472,6 +610,10 @@ private:
     const Scene* scene_;
     glm::dvec3 direction_;
     Stage stage_ = Stage::Done;
+    bool seeded_ = false;  // starts where a cone stopped, not on the bounds
+    bool cone_ = false;    // a cone of the pre-pass, not a camera ray
+    double spread_ = 0.0;
+    double coneStart_ = 0.0;
     Trace trace_;
     // Sphere tracing and bisection.
     Interval span_;
@@ -492,7 +634,8 @@ private:
     double hitEps_ = 0.0;
     double h_ = 0.0;  // central-difference step
     double open_ = 1.0;
-    std::vector<ShadowMarch> shadows_;  // one per light
+    glm::dvec3 shadowOrigin_{0.0};    // where the shadow marches start: just off the surface
+    ShadowMarch* shadows_ = nullptr;  // one per light (the caller's pool)
 };
 
 /// Answers the queries of ray jobs until every job is done: one query at a time with evaluate()
@@ -501,12 +644,16 @@ private:
 /// Holds only buffers, so one per thread is reused from tile to tile.
 class Evaluator {
 public:
+    /// Evaluations answered since the last call (all of them: rays, cones, shading).
+    std::uint64_t takeEvaluations() { return std::exchange(evaluations_, 0); }
+
     void run(const Scene& scene, RenderEngine engine, std::vector<RayJob>& jobs) {
         if (engine == RenderEngine::Scalar) {
             for (RayJob& job : jobs) {
                 while (!job.done()) {
                     points_.clear();
                     job.queries(points_);
+                    evaluations_ += points_.size();
                     probes_.clear();
                     for (const glm::dvec3& p : points_) probes_.push_back(Probe::of(scene.evaluateAt(p)));
                     job.answer(probes_.data());
@@ -514,71 +661,134 @@ public:
             }
             return;
         }
+        // Each job is visited once a round: it takes its answers and names its next queries at
+        // once, into the other points buffer, while its state is at hand.
         active_.clear();
-        for (std::size_t index = 0; index < jobs.size(); ++index)
-            if (!jobs[index].done()) active_.push_back(index);
+        points_.clear();
+        counts_.clear();
+        for (std::size_t index = 0; index < jobs.size(); ++index) {
+            if (jobs[index].done()) continue;
+            active_.push_back(index);
+            counts_.push_back(jobs[index].queries(points_));
+        }
         while (!active_.empty()) {
-            points_.clear();
-            counts_.clear();
-            for (const std::size_t index : active_) counts_.push_back(jobs[index].queries(points_));
+            evaluations_ += points_.size();
             evaluateBatch(scene);
+            nextPoints_.clear();
             std::size_t offset = 0;
             std::size_t kept = 0;
             for (std::size_t k = 0; k < active_.size(); ++k) {
                 RayJob& job = jobs[active_[k]];
-                job.answer(probes_.data() + offset);
+                job.answer(BatchEscapes{&batch_, offset});
                 offset += counts_[k];
-                if (!job.done()) active_[kept++] = active_[k];
+                if (job.done()) continue;
+                active_[kept] = active_[k];
+                counts_[kept++] = job.queries(nextPoints_);
             }
             active_.resize(kept);
+            counts_.resize(kept);
+            std::swap(points_, nextPoints_);
         }
     }
 
 private:
-    /// points_ -> probes_ through the SIMD kernel. The 8-D coordinates are Slice::map's
+    /// points_ -> batch_'s results through the SIMD kernel. The 8-D coordinates are Slice::map's
     /// expression, coordinate by coordinate, so they round the same; terms with a zero axis
     /// component are left out (they add a zero, which changes at most the sign of a zero).
     void evaluateBatch(const Scene& scene) {
         const std::size_t count = points_.size();
         const Slice& slice = scene.slice();
         batch_.resize(count);
+        const glm::dvec3* points = points_.data();
         for (int k = 0; k < 8; ++k) {
             double* out = batch_.start(k);
             const double origin = slice.origin[k];
-            std::fill(out, out + count, origin);
+            // A coordinate the slice does not move (5 of 8 on the usual slices) keeps its value
+            // from round to round: the kernel only reads the start points, so only the entries
+            // past those already holding this origin are written.
+            constants_[k] = std::min(constants_[k], count);
+            if (constants_[k] > 0 &&
+                std::bit_cast<std::uint64_t>(constantOrigin_[k]) != std::bit_cast<std::uint64_t>(origin))
+                constants_[k] = 0;
+            // One pass a coordinate: origin + p[a] * scale over its nonzero axes, in axis order
+            // (the same sums as adding one axis after the other).
+            int axes[3];
+            double scales[3];
+            int terms = 0;
             for (int axis = 0; axis < 3; ++axis) {
-                const double scale = slice.axes[axis][k];
-                if (scale == 0.0) continue;
-                for (std::size_t i = 0; i < count; ++i) out[i] += points_[i][axis] * scale;
+                if (slice.axes[axis][k] == 0.0) continue;
+                axes[terms] = axis;
+                scales[terms++] = slice.axes[axis][k];
+            }
+            if (terms == 0) {
+                std::fill(out + constants_[k], out + count, origin);
+                constants_[k] = count;
+                constantOrigin_[k] = origin;
+                continue;
+            }
+            constants_[k] = 0;
+            switch (terms) {
+                case 1:
+                    for (std::size_t i = 0; i < count; ++i) out[i] = origin + points[i][axes[0]] * scales[0];
+                    break;
+                case 2:
+                    for (std::size_t i = 0; i < count; ++i)
+                        out[i] = origin + points[i][axes[0]] * scales[0] + points[i][axes[1]] * scales[1];
+                    break;
+                default:
+                    for (std::size_t i = 0; i < count; ++i)
+                        out[i] = origin + points[i][axes[0]] * scales[0] + points[i][axes[1]] * scales[1] +
+                                 points[i][axes[2]] * scales[2];
+                    break;
             }
         }
         batch_.evaluate(scene.fractal());
-        probes_.resize(count);
-        for (std::size_t i = 0; i < count; ++i)
-            probes_[i] = {batch_.n(i), batch_.r(i), batch_.ra(i), batch_.rb(i), batch_.de(i), batch_.trap(i)};
     }
 
+    /// The kernel's results from `first` on, read in place as Probes (RayJob::answer).
+    struct BatchEscapes {
+        const BatchBuffer<double>* batch;
+        std::size_t first;
+        Probe operator[](std::size_t i) const {
+            const std::size_t j = first + i;
+            return {batch->n(j), batch->r(j), batch->ra(j), batch->rb(j), batch->de(j), batch->trap(j)};
+        }
+    };
+
     std::vector<glm::dvec3> points_;
-    std::vector<Probe> probes_;
+    std::vector<glm::dvec3> nextPoints_;  // the next round's, filled while answering this one
+    std::vector<Probe> probes_;           // the scalar engine's escapes
     std::vector<std::size_t> counts_;
     std::vector<std::size_t> active_;
     BatchBuffer<double> batch_;
+    // Per 8-D coordinate: how many leading start points hold constantOrigin_ (a coordinate the
+    // slice does not move), still valid from the last round.
+    std::array<std::size_t, 8> constants_{};
+    std::array<double, 8> constantOrigin_{};
+    std::uint64_t evaluations_ = 0;
 };
 
 struct TileStats {
     std::uint64_t rays = 0;
     std::uint64_t steps = 0;
     std::uint64_t hitPixels = 0;
+    std::uint64_t evaluations = 0;
 };
 
-/// A thread's rays in flight and their evaluator, reused from tile to tile.
-struct TileScratch {
+/// A thread's buffers for its tiles, kept from tile to tile (no allocation once they have
+/// grown): render() keeps one per thread in a ThreadScratch.
+struct TileBuffers {
     Evaluator evaluator;
     std::vector<RayJob> jobs;
+    std::vector<ShadowMarch> shadowSlots;  // the jobs' shadow marches (RayJob's `shadows`)
+    std::vector<double> columnX;           // image plane x of the tile's sub-pixel columns
+    std::vector<double> rowY;              // and y of its rows
+    std::vector<double> starts;            // per cone block: where its rays start (+inf: all miss)
+    std::vector<std::size_t> firstJob;     // per pixel of the pass: its first job, or kNoJob
 };
 
 TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, int x1, int y1, Image& image,
-                     TileScratch& scratch) {
+                     TileBuffers& buffers) {
     TileStats stats;
     const CameraFrame& camera = scene.camera();
     const int samples = scene.samples();
@@ -588,24 +798,108 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
     const int pixels = width * (y1 - y0);
     // The tile's pixels go through in passes of about kRaysPerPass rays, whole pixels at a time.
     const int pixelsPerPass = std::max(1, kRaysPerPass / perPixel);
-    Evaluator& evaluator = scratch.evaluator;
-    std::vector<RayJob>& jobs = scratch.jobs;
+    Evaluator& evaluator = buffers.evaluator;
+    std::vector<RayJob>& jobs = buffers.jobs;
+    // Room for the shadow marches of a pass's rays: job k has the lights' slots from k * lights.
+    std::vector<ShadowMarch>& shadowSlots = buffers.shadowSlots;
+    const std::size_t lights = scene.lightCount();
+    shadowSlots.resize(std::max(shadowSlots.size(), static_cast<std::size_t>(pixelsPerPass) * perPixel * lights));
+    // A regular grid of sub-pixel positions; with one sample, the pixel centre. Their image
+    // plane coordinates, per sub-pixel column and row of the tile, are worked out once.
+    std::vector<double>& columnX = buffers.columnX;
+    std::vector<double>& rowY = buffers.rowY;
+    columnX.clear();
+    rowY.clear();
+    for (int x = x0; x < x1; ++x)
+        for (int sx = 0; sx < samples; ++sx) columnX.push_back(screenX(camera, x + (sx + 0.5) / samples));
+    for (int y = y0; y < y1; ++y)
+        for (int sy = 0; sy < samples; ++sy) rowY.push_back(screenY(camera, y + (sy + 0.5) / samples));
+    auto sampleDirection = [&](int x, int y, int sx, int sy) {
+        const int column = (x - x0) * samples + sx;
+        const int row = (y - y0) * samples + sy;
+        return screenDirection(camera, columnX[static_cast<std::size_t>(column)], rowY[static_cast<std::size_t>(row)]);
+    };
+    // The cone pre-pass: one cone around each block of kConeBlock^2 pixels finds how far all
+    // their rays may go before they can come near the set.
+    const int blocksX = (width + kConeBlock - 1) / kConeBlock;
+    const int blocksY = (y1 - y0 + kConeBlock - 1) / kConeBlock;
+    jobs.clear();
+    for (int by = 0; by < blocksY; ++by) {
+        for (int bx = 0; bx < blocksX; ++bx) {
+            const int bx0 = x0 + bx * kConeBlock, by0 = y0 + by * kConeBlock;
+            const int bx1 = std::min(x1, bx0 + kConeBlock), by1 = std::min(y1, by0 + kConeBlock);
+            const glm::dvec3 axis = camera.rayDirection(0.5 * (bx0 + bx1), 0.5 * (by0 + by1));
+            double spread = 0.0;  // the farthest corner: a ray at t is within spread * t of the axis
+            for (const int cy : {by0, by1})
+                for (const int cx : {bx0, bx1})
+                    spread = std::max(spread, glm::length(camera.rayDirection(cx, cy) - axis));
+            // Its rays meet the bounds only where the axis comes within radius + spread * t of
+            // the centre: the axis through the sphere grown by its spread at the farthest t.
+            Bounds grown = scene.bounds();
+            grown.radius += spread * (glm::length(camera.eye - grown.center) + grown.radius);
+            const Interval span = intersectSphere(camera.eye, axis, grown);
+            const double near = span.valid ? span.near : kInfinity;
+            const double far = span.valid ? span.far : kInfinity;
+            jobs.push_back(RayJob::cone(scene, axis, 1.01 * spread, near, far));
+        }
+    }
+    evaluator.run(scene, engine, jobs);
+    std::vector<double>& starts = buffers.starts;
+    std::vector<std::size_t>& firstJob = buffers.firstJob;
+    constexpr std::size_t kNoJob = std::numeric_limits<std::size_t>::max();
+    starts.clear();
+    for (const RayJob& job : jobs) starts.push_back(job.coneStart());
     for (int first = 0; first < pixels; first += pixelsPerPass) {
         const int last = std::min(pixels, first + pixelsPerPass);
         jobs.clear();
+        firstJob.clear();
         for (int index = first; index < last; ++index) {
             const int x = x0 + index % width;
             const int y = y0 + index / width;
-            for (int sy = 0; sy < samples; ++sy) {
-                for (int sx = 0; sx < samples; ++sx) {
-                    // A regular grid of sub-pixel positions; with one sample, the pixel centre.
-                    const double px = x + (sx + 0.5) / samples;
-                    const double py = y + (sy + 0.5) / samples;
-                    jobs.emplace_back(scene, camera.rayDirection(px, py));
-                }
-            }
+            const std::size_t block = static_cast<std::size_t>((y - y0) / kConeBlock) * blocksX + (x - x0) / kConeBlock;
+            const double start = starts[block];
+            // A pixel whose cone left the bounds misses with every sample: no rays to trace.
+            firstJob.push_back(start == kInfinity ? kNoJob : jobs.size());
+            if (start == kInfinity) continue;
+            for (int sy = 0; sy < samples; ++sy)
+                for (int sx = 0; sx < samples; ++sx)
+                    jobs.emplace_back(scene, sampleDirection(x, y, sx, sy), start,
+                                      shadowSlots.data() + jobs.size() * lights);
         }
         evaluator.run(scene, engine, jobs);
+        // Occlusion and shadows vary slowly over the surface: the first sample of a pixel to
+        // hit shades itself, the pixel's others on the same piece of surface take its values.
+        bool paused = false;
+        for (int index = first; index < last; ++index) {
+            const std::size_t pixelJobs = firstJob[static_cast<std::size_t>(index - first)];
+            for (int sample = 0; sample < perPixel && pixelJobs != kNoJob; ++sample) {
+                if (!jobs[pixelJobs + sample].paused()) continue;
+                jobs[pixelJobs + sample].resumeShading();
+                paused = true;
+                break;
+            }
+        }
+        if (paused) {
+            evaluator.run(scene, engine, jobs);
+            for (int index = first; index < last; ++index) {
+                const std::size_t pixelJobs = firstJob[static_cast<std::size_t>(index - first)];
+                if (pixelJobs == kNoJob) continue;
+                const RayJob* leader = nullptr;
+                for (int sample = 0; sample < perPixel; ++sample) {
+                    RayJob& job = jobs[pixelJobs + sample];
+                    if (!job.paused()) {
+                        if (leader == nullptr && job.trace().hit) leader = &job;
+                        continue;
+                    }
+                    if (leader != nullptr && job.canShareShading(*leader)) {
+                        job.shareShading(*leader);
+                    } else {
+                        job.resumeShading();
+                    }
+                }
+            }
+            evaluator.run(scene, engine, jobs);
+        }
         for (int index = first; index < last; ++index) {
             const int x = x0 + index % width;
             const int y = y0 + index / width;
@@ -614,8 +908,13 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
             glm::dvec3 normalSum(0.0);
             double depth = kInfinity;
             int hits = 0;
-            for (int sample = 0; sample < perPixel; ++sample) {
-                const RayJob& job = jobs[static_cast<std::size_t>(index - first) * perPixel + sample];
+            const std::size_t pixelJobs = firstJob[static_cast<std::size_t>(index - first)];
+            for (int sample = 0; sample < perPixel && pixelJobs == kNoJob; ++sample) {
+                ++stats.rays;  // the background, as a missing ray's job would give it
+                colour += scene.background(sampleDirection(x, y, sample % samples, sample / samples));
+            }
+            for (int sample = 0; sample < perPixel && pixelJobs != kNoJob; ++sample) {
+                const RayJob& job = jobs[pixelJobs + sample];
                 ++stats.rays;
                 stats.steps += job.trace().steps;
                 colour += job.colour();
@@ -641,16 +940,14 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
             if (hits > 0) ++stats.hitPixels;
         }
     }
+    stats.evaluations = evaluator.takeEvaluations();
     return stats;
 }
 
 }  // namespace
 
 glm::dvec3 CameraFrame::rayDirection(double px, double py) const {
-    const double aspect = static_cast<double>(width) / height;
-    const double x = (2.0 * px / width - 1.0) * tanHalfFov * aspect;
-    const double y = (1.0 - 2.0 * py / height) * tanHalfFov;  // image rows go down, `up` goes up
-    return glm::normalize(forward + x * right + y * up);
+    return screenDirection(*this, screenX(*this, px), screenY(*this, py));
 }
 
 CameraFrame frameCamera(const Params& params, const Bounds& bounds) {
@@ -706,7 +1003,8 @@ RenderResult render(const Params& params, const ProgressCallback& progress, Rend
     std::atomic<std::uint64_t> rays{0};
     std::atomic<std::uint64_t> steps{0};
     std::atomic<std::uint64_t> hitPixels{0};
-    ThreadScratch<TileScratch> scratch;
+    std::atomic<std::uint64_t> evaluations{0};
+    ThreadScratch<TileBuffers> scratch;  // each thread's TileBuffers, reused from tile to tile
     parallelForWithProgress(static_cast<std::size_t>(tilesX) * tilesY, progress,
                             [&](std::size_t index, const std::atomic<bool>&) {
                                 const int x0 = static_cast<int>(index % tilesX) * kTileSize;
@@ -717,11 +1015,13 @@ RenderResult render(const Params& params, const ProgressCallback& progress, Rend
                                 rays += tile.rays;
                                 steps += tile.steps;
                                 hitPixels += tile.hitPixels;
+                                evaluations += tile.evaluations;
                             });
 
     result.stats.rays = rays;
     result.stats.steps = steps;
     result.stats.hitPixels = hitPixels;
+    result.stats.evaluations = evaluations;
     result.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return result;
 }

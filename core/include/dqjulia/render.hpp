@@ -40,6 +40,9 @@ struct RenderStats {
     std::uint64_t rays = 0;
     std::uint64_t steps = 0;      ///< sphere-tracing steps over all rays
     std::uint64_t hitPixels = 0;  ///< pixels with at least one sample on the surface
+    /// Fractal evaluations over all rays: marching (with the cone pre-pass), bisection, normals,
+    /// occlusion and shadow probes
+    std::uint64_t evaluations = 0;
     double seconds = 0.0;
 };
 
