@@ -1,7 +1,6 @@
 // dqjulia bake: the fractal as an OpenVDB file (level set "surface", fog volume "density",
 // attribute grids), one file or, with --frames, one file per frame of an animation; with
 // --tiles, tiles of it for dqjulia merge.
-#include <filesystem>
 #include <iomanip>
 #include <iostream>
 
@@ -12,7 +11,6 @@
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/threads.hpp"
 #include "dqjulia/tiles.hpp"
-#include "file_names.hpp"
 
 namespace dqj::cli {
 namespace {
@@ -49,10 +47,7 @@ std::vector<Job> plan(const BakeFlags& flags, const Params& params) {
     }
     std::vector<Job> todo;
     for (Job& job : jobs) {
-        if (flags.skipExisting && std::filesystem::is_regular_file(pathFromUtf8(job.path))) {
-            if (!flags.quiet) std::cerr << "skipped " << job.path << ": it exists (--skip-existing)\n";
-            continue;
-        }
+        if (flags.skips(job.path)) continue;
         checkOutputPath(job.path, flags.force);
         todo.push_back(std::move(job));
     }

@@ -9,9 +9,11 @@
 #endif
 
 #include "dqjulia/threads.hpp"
+#include "file_names.hpp"
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 
 namespace dqj::cli {
@@ -144,6 +146,12 @@ void BakeFlags::checkExistingFlags() const {
     if (force && skipExisting)
         throw ParamError("output.path",
                          "--force replaces existing outputs and --skip-existing keeps them: give one of the two");
+}
+
+bool BakeFlags::skips(const std::string& path) const {
+    if (!skipExisting || !std::filesystem::is_regular_file(pathFromUtf8(path))) return false;
+    if (!quiet) std::cerr << "skipped " << path << ": it exists (--skip-existing)\n";
+    return true;
 }
 
 std::vector<std::pair<int, std::string>> framePaths(const BakeFlags& flags) {

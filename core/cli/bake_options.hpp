@@ -61,6 +61,9 @@ struct BakeFlags {
     /// What an existing output means: refused (the default), replaced (--force) or skipped
     /// (--skip-existing). Throws ParamError for both flags at once.
     void checkExistingFlags() const;
+    /// Whether --skip-existing skips the output at `path`: it is complete, since a final file exists
+    /// only once written whole. Says so on stderr unless quiet.
+    bool skips(const std::string& path) const;
 };
 
 /// "out/fractal.vdb", 12 -> "out/fractal_0012.vdb": the numbering Blender reads as a sequence.

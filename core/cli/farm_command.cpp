@@ -26,6 +26,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "atomic_file.hpp"
 #include "bake_options.hpp"
 #include "commands.hpp"
 #include "common.hpp"
@@ -87,12 +88,6 @@ std::string shellQuote(const std::string& text) {
     return quoted + "'";
 }
 
-std::string lowercaseExtension(const std::string& path) {
-    std::string extension = utf8FromPath(pathFromUtf8(path).extension());
-    for (char& ch : extension) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-    return extension;
-}
-
 std::string withoutExtension(const std::string& path) {
     return utf8FromPath(pathFromUtf8(path).parent_path() / pathFromUtf8(path).stem());
 }
@@ -125,7 +120,7 @@ FarmPlan plan(const FarmFlags& flags, const std::string& fileFlag, const std::st
     plan.params = bake.load();
     const Params& params = plan.params;
     plan.output = utf8FromPath(fs::absolute(pathFromUtf8(bake.output)).lexically_normal());
-    if (lowercaseExtension(plan.output) != ".vdb")
+    if (AtomicFile::lowercaseExtension(plan.output) != ".vdb")
         throw ParamError("output.path", "--output '" + bake.output + "' must end in .vdb");
     plan.frames = bake.frameRange();
     plan.chunk = flags.chunk;

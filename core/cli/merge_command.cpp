@@ -36,10 +36,7 @@ int runMerge(const MergeFlags& flags) {
     for (const auto& [frame, path] : framePaths(bake)) {
         std::vector<std::string> inputs = flags.inputs;
         for (int index = 1; tiling && index <= tileCount(*tiling); ++index) inputs.push_back(tilePath(path, index));
-        if (bake.skipExisting && std::filesystem::is_regular_file(pathFromUtf8(path))) {
-            if (!bake.quiet) std::cerr << "skipped " << path << ": it exists (--skip-existing)\n";
-            continue;
-        }
+        if (bake.skips(path)) continue;
         std::string missing;
         for (const std::string& input : inputs)
             if (!std::filesystem::is_regular_file(pathFromUtf8(input)))

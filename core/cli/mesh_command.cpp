@@ -1,6 +1,5 @@
 // dqjulia mesh: the baked surface as a PLY or OBJ mesh (normals, vertex colours), one file or,
 // with --frames, one file per frame of an animation.
-#include <filesystem>
 #include <iomanip>
 #include <iostream>
 
@@ -27,10 +26,7 @@ int runMesh(const BakeFlags& flags) {
     std::vector<Params> perFrame;
     std::vector<std::string> paths;
     for (const auto& [frame, path] : framePaths(flags)) {
-        if (flags.skipExisting && std::filesystem::is_regular_file(path)) {
-            if (!flags.quiet) std::cerr << "skipped " << path << ": it exists (--skip-existing)\n";
-            continue;
-        }
+        if (flags.skips(path)) continue;
         frames.push_back(frame);
         perFrame.push_back(paramsAtFrame(params, frame));
         paths.push_back(path);
