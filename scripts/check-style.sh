@@ -11,7 +11,7 @@
 # main itself or there is no main; changes not committed yet count too. ruff's lint and
 # clang-tidy report only findings on changed lines, so old code does not block new.
 # Tools: clang-format and clang-tidy from Debian (scripts/install-deps.sh), ruff from
-# scripts/ruff-env.sh; DQJ_CLANG_FORMAT, DQJ_CLANG_TIDY, DQJ_RUFF name others, DQJ_BUILD_DIR
+# scripts/tool-env.sh ruff; DQJ_CLANG_FORMAT, DQJ_CLANG_TIDY, DQJ_RUFF name others, DQJ_BUILD_DIR
 # another build tree. A missing tool is reported and skipped (DQJ_TEST_SKIPPED, as the tests
 # say it), except under CI=true, where it fails.
 # Exit status: 0 clean, 1 findings (or a missing tool in CI), 2 usage.
@@ -28,7 +28,7 @@ esac
 
 clang_format="${DQJ_CLANG_FORMAT:-clang-format}"
 clang_tidy="${DQJ_CLANG_TIDY:-clang-tidy}"
-ruff="${DQJ_RUFF:-$(scripts/ruff-env.sh --print || true)}"
+ruff="${DQJ_RUFF:-$(scripts/tool-env.sh ruff --print || true)}"
 build="${DQJ_BUILD_DIR:-build}"
 jobs="$(nproc)"
 
@@ -131,7 +131,7 @@ done
 # ruff: lint findings on changed lines; format per changed range (ruff formats one range a run).
 if [ ${#python[@]} -gt 0 ]; then
   if [ -z "$ruff" ] || ! have "$ruff"; then
-    missing "ruff is not installed (scripts/ruff-env.sh installs it)"
+    missing "ruff is not installed (scripts/tool-env.sh ruff installs it)"
   else
     if [ "$mode" = all ]; then
       "$ruff" check --quiet --output-format concise "${python[@]}" || failed=1

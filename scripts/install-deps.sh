@@ -12,7 +12,7 @@ packages=(
   blender  # the bake tests load the VDB files and meshes in the real Blender (tests/blender)
   xvfb xauth glslang-tools  # the add-on's preview in a real Blender window (xvfb-run); its GLSL checked
   povray  # tests/povray evaluate dqjulia.inc and render generated scenes in the real POV-Ray 3.7
-  clang-format clang-tidy  # scripts/check-style.sh (the test style.check); ruff comes from scripts/ruff-env.sh
+  clang-format clang-tidy  # scripts/check-style.sh (the test style.check); ruff comes from scripts/tool-env.sh ruff
   slurm-wlm munge  # tests/farm: a one-node Slurm cluster on localhost runs a frame array and a tiled bake
   g++-mingw-w64-x86-64-posix wine64  # the Windows build (scripts/build-windows.sh) and its tests under Wine
 )

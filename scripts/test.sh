@@ -7,8 +7,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
 scripts/bpy-env.sh
-scripts/ruff-env.sh
-scripts/openjd-env.sh
+scripts/tool-env.sh ruff
+scripts/tool-env.sh openjd
 scripts/build.sh
 ctest --test-dir build --output-on-failure -j"$(nproc)"
 

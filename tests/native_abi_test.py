@@ -15,6 +15,8 @@ import re
 import subprocess
 import sys
 
+from check_report import report
+
 CTYPES = {
     "int32_t": ctypes.c_int32,
     "double": ctypes.c_double,
@@ -95,12 +97,7 @@ def main():
                 found = sizes.get("%s.%s" % (struct, field))
                 checks["%s.%s at %s in C, %s in ctypes" % (struct, field, found, expected)] = found == expected
 
-    for name, ok in checks.items():
-        if not ok:
-            print("FAIL: %s" % name)
-    failed = sum(not ok for ok in checks.values())
-    print("%d passed, %d failed" % (len(checks) - failed, failed))
-    return 1 if failed else 0
+    return report(checks, failures_only=True)
 
 
 if __name__ == "__main__":

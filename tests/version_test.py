@@ -14,10 +14,13 @@ import sys
 import tomllib
 import zipfile
 
+from check_report import report
+
 
 def main():
     source, zip_path, cli, library = sys.argv[1:5]
-    version = open(source + "/VERSION").read().strip()
+    with open(source + "/VERSION") as handle:
+        version = handle.read().strip()
     major, minor, patch = (int(part) for part in version.split("."))
     checks = {}
 
@@ -60,11 +63,7 @@ def main():
         re.search(r"^## (%s|Unreleased)\b" % re.escape(version), changelog, re.M) is not None
     )
 
-    for name, ok in checks.items():
-        print("%s: %s" % ("ok" if ok else "FAIL", name))
-    failed = sum(not ok for ok in checks.values())
-    print("%d passed, %d failed" % (len(checks) - failed, failed))
-    return 1 if failed else 0
+    return report(checks)
 
 
 if __name__ == "__main__":

@@ -19,6 +19,9 @@ import subprocess
 import sys
 import zipfile
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from check_report import report  # noqa: E402 (tests/check_report.py)
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 SUITE = "bookworm"
 
@@ -123,11 +126,7 @@ def main():
     checks["errors explained (%s)" % clean["error_message"]] = (
         clean["error_message"] == host["error_message"] and "iterations" in clean["error_message"]
     )
-    failed = [name for name, ok in checks.items() if not ok]
-    for name, ok in checks.items():
-        print("%s: %s" % ("ok" if ok else "FAIL", name))
-    print("%d passed, %d failed" % (len(checks) - len(failed), len(failed)))
-    return 1 if failed else 0
+    return report(checks)
 
 
 if __name__ == "__main__":

@@ -24,6 +24,9 @@ import subprocess
 import sys
 import time
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from check_report import skip_or_fail  # noqa: E402 (tests/check_report.py)
+
 ANIMATION = {
     "slice": {"rotations": [{"plane": "a.j,b.s", "degrees": 0}]},
     "animation": {
@@ -31,13 +34,6 @@ ANIMATION = {
         "fractal.iterations": [{"frame": 1, "value": 8}, {"frame": 4, "value": 12}],
     },
 }
-
-
-def skip_or_fail(reason):
-    if os.environ.get("CI") == "true":
-        sys.exit("FAIL: %s (CI=true: every test must run)" % reason)
-    print("DQJ_TEST_SKIPPED: %s" % reason)
-    sys.exit(0)
 
 
 def run(command, **kwargs):
@@ -138,7 +134,7 @@ def test_slurm(args):
 
 def test_openjd(args):
     if not args.openjd or not os.access(args.openjd, os.X_OK):
-        skip_or_fail("openjd is not installed (scripts/openjd-env.sh installs openjd-cli)")
+        skip_or_fail("openjd is not installed (scripts/tool-env.sh openjd installs openjd-cli)")
     params = prepare(args.work)
     output = os.path.join(args.work, "job", "anim.vdb")
     os.makedirs(os.path.dirname(output))
@@ -177,7 +173,7 @@ def main():
     parser.add_argument("--cli", required=True)
     parser.add_argument("--work", required=True)
     parser.add_argument("--cluster", help="scripts/slurm-local.sh")
-    parser.add_argument("--openjd", help="the openjd command (scripts/openjd-env.sh --print)")
+    parser.add_argument("--openjd", help="the openjd command (scripts/tool-env.sh openjd --print)")
     args = parser.parse_args()
     (test_slurm if args.engine == "slurm" else test_openjd)(args)
     print("%s passed" % args.engine)

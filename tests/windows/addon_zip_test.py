@@ -19,12 +19,8 @@ import sys
 import types
 import zipfile
 
-
-def skip_or_fail(reason):
-    if os.environ.get("CI") == "true":
-        raise SystemExit("FAIL: %s (CI=true: every test must run)" % reason)
-    print("DQJ_TEST_SKIPPED: %s" % reason)
-    sys.exit(0)
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from check_report import report, skip_or_fail  # noqa: E402 (tests/check_report.py)
 
 
 def platforms(archive):
@@ -107,11 +103,7 @@ def main():
     checks["native.py on Windows adds the DLL's folder first: %s" % added] = added == [os.path.dirname(library)]
     checks["native.py on Windows binds every function (%d)" % len(bound)] = bound == frozenset(native._SIGNATURES)
 
-    for name, ok in checks.items():
-        print("%s: %s" % ("ok" if ok else "FAIL", name))
-    failed = sum(not ok for ok in checks.values())
-    print("%d passed, %d failed" % (len(checks) - failed, failed))
-    return 1 if failed else 0
+    return report(checks)
 
 
 if __name__ == "__main__":

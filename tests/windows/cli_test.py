@@ -12,6 +12,9 @@ import shutil
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from check_report import report, skip_or_fail  # noqa: E402 (tests/check_report.py)
+
 FOLDER = "cli \u00e9t\u00e9 \u65e5\u672c"  # "cli été 日本"
 
 # (name, arguments, compare_outputs kind): the default picture, and a bake and a mesh small enough
@@ -31,13 +34,6 @@ def windows_path(path):
 def run(command):
     result = subprocess.run(command, capture_output=True, text=True, encoding="utf-8", errors="replace")
     return result.returncode, result.stdout + result.stderr
-
-
-def skip_or_fail(reason):
-    if os.environ.get("CI") == "true":
-        raise SystemExit("FAIL: %s (CI=true: every test must run)" % reason)
-    print("DQJ_TEST_SKIPPED: %s" % reason)
-    sys.exit(0)
 
 
 def main():
@@ -80,11 +76,7 @@ def main():
     checks["the folder holds the outputs and nothing else (no temporary file): %s" % names] = names == sorted(
         name for name, _, _ in OUTPUTS
     )
-    for name, ok in checks.items():
-        print("%s: %s" % ("ok" if ok else "FAIL", name))
-    failed = sum(not ok for ok in checks.values())
-    print("%d passed, %d failed" % (len(checks) - failed, failed))
-    return 1 if failed else 0
+    return report(checks)
 
 
 if __name__ == "__main__":

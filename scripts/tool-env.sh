@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# A pinned command-line tool from PyPI in a virtual environment cached outside the checkout, in
+# ${XDG_CACHE_HOME:-$HOME/.cache}/dqjulia/<tool>/<version> (or $DQJ_RUFF_CACHE, $DQJ_OPENJD_CACHE):
+#   ruff     the Python linter and formatter of scripts/check-style.sh (about 15 MB)
+#   openjd   Open Job Description's reference runner for tests/farm (openjd-cli, about 20 MB)
+#
+#   scripts/tool-env.sh TOOL           make the venv if it is missing (an existing one costs nothing)
+#   scripts/tool-env.sh TOOL --print   print the tool's program (installs nothing; exit 1 if absent)
+#
+# As in scripts/bpy-env.sh, the venv is made in a temporary folder beside its final place and
+# renamed into place once pip has finished, so a half-made one is never used; one whose
+# `TOOL --version` fails is made again.
+set -euo pipefail
+
+usage() { echo "usage: tool-env.sh ruff|openjd [--print]" >&2; exit 2; }
+[ $# -ge 1 ] || usage
+tool="$1"
+shift
+case "$tool" in
+  ruff) version=0.17.5 package="ruff==$version" cache="${DQJ_RUFF_CACHE:-}" ;;
+  openjd) version=0.8.0 package="openjd-cli==$version" cache="${DQJ_OPENJD_CACHE:-}" ;;
+  *) usage ;;
+esac
+cache="${cache:-${XDG_CACHE_HOME:-$HOME/.cache}/dqjulia/$tool}"
+venv="$cache/$version"
+program="$venv/bin/$tool"
+
+if [ "${1:-}" = "--print" ]; then
+  echo "$program"
+  [ -x "$program" ]
+  exit $?
+fi
+[ $# -eq 0 ] || usage
+
+if [ -x "$program" ] && "$program" --version >/dev/null 2>&1; then
+  exit 0
+fi
+mkdir -p "$cache"
+echo "dqjulia: making the $package venv in $venv" >&2
+tmp="$(mktemp -d "$cache/.$version.XXXXXX")"
+trap 'rm -rf "$tmp"' EXIT
+python3 -m venv "$tmp/venv"
+# `python -m pip`: pip's own #! line would name the temporary folder after the move.
+"$tmp/venv/bin/python" -m pip install --quiet --no-input --disable-pip-version-check "$package"
+rm -rf "$venv"
+mv "$tmp/venv" "$venv"
+# A Python entry point's #! line names the venv's python: after the move, point it there (ruff's
+# program is native and has none).
+if [ "$(head -c 2 "$program")" = "#!" ]; then
+  sed -i "1s|^#!.*|#!$venv/bin/python|" "$program"
+fi
+"$program" --version >/dev/null
