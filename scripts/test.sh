@@ -6,9 +6,20 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
-scripts/bpy-env.sh
-scripts/tool-env.sh ruff
-scripts/tool-env.sh openjd
+# The Python venvs (on a fresh machine about 800 MB of bpy wheels from PyPI: network, not CPU)
+# are made while the static third-party libraries compile; the build's configure step looks for
+# them, so it waits for both.
+venvs_log="$(mktemp)"
+trap 'rm -f "$venvs_log"' EXIT
+(scripts/bpy-env.sh && scripts/tool-env.sh ruff && scripts/tool-env.sh openjd) >"$venvs_log" 2>&1 &
+venvs=$!
+scripts/build-deps.sh >/dev/null
+if ! wait "$venvs"; then
+  cat "$venvs_log" >&2
+  echo "dqjulia: making the Python venvs failed (scripts/bpy-env.sh, scripts/tool-env.sh)" >&2
+  exit 1
+fi
+cat "$venvs_log"
 scripts/build.sh
 ctest --test-dir build --output-on-failure -j"$(nproc)"
 
