@@ -5,11 +5,15 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -374,4 +378,34 @@ TEST(RenderProgress, ReturningFalseCancels) {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     EXPECT_EQ(calls.load(), 1) << "no calls after cancelling";
     std::printf("    cancelled after %.2f s\n", seconds);
+}
+
+// linearToSrgb8 reads a table, not pow: its code must be the formula's (sRGB-encoded, times
+// 255, rounded) for every float. Here every 61st float of [0, 1] and each float within 64 of a
+// code's step; DQJ_SRGB_EVERY_FLOAT=1 checks all 1,065,353,217 of them (about 30 s).
+TEST(Image, Srgb8CodesAreTheFormulas) {
+    auto formula = [](float linear) { return int(std::lround(encodeSrgb(linear) * 255.0)); };
+    const std::uint32_t one = std::bit_cast<std::uint32_t>(1.0f);
+    const std::uint32_t stride = std::getenv("DQJ_SRGB_EVERY_FLOAT") ? 1 : 61;
+    std::uint64_t checked = 0, differ = 0;
+    int previous = 0;
+    for (std::uint32_t bits = 0; bits <= one; bits += stride) {
+        const float linear = std::bit_cast<float>(bits);
+        const int code = formula(linear);
+        // Around a step (the code changes): every float within 64 of it.
+        const std::uint32_t from = code != previous && bits >= stride ? bits - stride : bits;
+        const std::uint32_t to = code != previous ? std::min(bits + 64, one) : bits;
+        for (std::uint32_t near = from; near <= to; ++near) {
+            const float x = std::bit_cast<float>(near);
+            ++checked;
+            differ += dqj::linearToSrgb8(x) != formula(x);
+        }
+        previous = code;
+    }
+    EXPECT_EQ(differ, 0u) << "of " << checked;
+    EXPECT_GT(checked, one / 61);
+    EXPECT_EQ(dqj::linearToSrgb8(-0.5f), 0);
+    EXPECT_EQ(dqj::linearToSrgb8(std::nanf("")), 0);
+    EXPECT_EQ(dqj::linearToSrgb8(1.5f), 255);
+    EXPECT_EQ(dqj::linearToSrgb8(std::numeric_limits<float>::infinity()), 255);
 }
