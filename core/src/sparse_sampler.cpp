@@ -2,6 +2,7 @@
 #include "sparse_sampler.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <memory>
@@ -81,13 +82,14 @@ std::size_t pruneAwayFromSurface(openvdb::FloatTree& tree, float background) {
                               for (auto value = leaf.cbeginValueAll(); value && !inside; ++value)
                                   inside = *value < 0.0f;
                               const Coord low = leaf.origin().offsetBy(-1), high = leaf.origin().offsetBy(kLeafSize);
+                              // The shell's voxels only: all of a side column, the two ends of the others.
                               for (int x = low.x(); x <= high.x() && !inside; ++x)
-                                  for (int y = low.y(); y <= high.y() && !inside; ++y)
-                                      for (int z = low.z(); z <= high.z() && !inside; ++z) {
-                                          const bool shell = x == low.x() || x == high.x() || y == low.y() ||
-                                                             y == high.y() || z == low.z() || z == high.z();
-                                          if (shell) inside = accessor.getValue(Coord(x, y, z)) < 0.0f;
-                                      }
+                                  for (int y = low.y(); y <= high.y() && !inside; ++y) {
+                                      const bool side = x == low.x() || x == high.x() || y == low.y() || y == high.y();
+                                      const int step = side ? 1 : high.z() - low.z();
+                                      for (int z = low.z(); z <= high.z() && !inside; z += step)
+                                          inside = accessor.getValue(Coord(x, y, z)) < 0.0f;
+                                  }
                               prunable[index] = !inside;
                           }
                       });
@@ -439,23 +441,30 @@ void SurfaceFunction::operator()(const glm::dvec3* points, std::size_t count, fl
     BatchBuffer<double>& batch = scratch.batch;
     std::vector<std::size_t>& evaluated = scratch.evaluated;  // indices of the points inside the region
     std::vector<double>& distances = scratch.distances;       // and their region distances, computed once
-    batch.clear();
-    evaluated.clear();
-    distances.clear();
+    // Room for every point, written in place and cut to the points inside the region (no
+    // push_back's capacity check per coordinate).
+    batch.resize(count);
+    evaluated.resize(count);
+    distances.resize(count);
+    std::array<double*, 8> coordinates;
+    for (int k = 0; k < 8; ++k) coordinates[k] = batch.start(k);
+    std::size_t inside = 0;
     for (std::size_t i = 0; i < count; ++i) {
         const double regionDistance = region_.signedDistance(points[i]);
         if (regionDistance > 0.0) {
             values[i] = float(std::min(regionDistance, double(background_)));
-        } else {
-            batch.add(slice_.map(points[i]));
-            evaluated.push_back(i);
-            distances.push_back(regionDistance);
+            continue;
         }
+        const Vec8 z = toVec8(slice_.map(points[i]));
+        for (int k = 0; k < 8; ++k) coordinates[k][inside] = z[k];
+        evaluated[inside] = i;
+        distances[inside] = regionDistance;
+        ++inside;
     }
+    batch.resize(inside);
     batch.evaluate(fractal_);
-    evaluations += evaluated.size();
-    for (std::size_t k = 0; k < evaluated.size(); ++k)
-        values[evaluated[k]] = value(batch.n(k), batch.de(k), distances[k]);
+    evaluations += inside;
+    for (std::size_t k = 0; k < inside; ++k) values[evaluated[k]] = value(batch.n(k), batch.de(k), distances[k]);
 }
 
 CoordBBox bakeIndexBox(const Params& params) {

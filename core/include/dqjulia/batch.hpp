@@ -87,7 +87,8 @@ public:
     }
     /// Appends a start point; returns its index.
     std::size_t add(const DualQuat& z) {
-        for (int k = 0; k < 8; ++k) start_[k].push_back(static_cast<T>(component(z, k)));
+        const Vec8 coordinates = toVec8(z);  // unrolled there: no branch on k per coordinate here
+        for (int k = 0; k < 8; ++k) start_[k].push_back(static_cast<T>(coordinates[k]));
         return size() - 1;
     }
     /// Makes room for `count` start points, to be written through start(k) (faster than add()).

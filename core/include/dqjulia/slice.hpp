@@ -33,10 +33,10 @@ struct Slice {
     std::array<Vec8, 3> axes{Vec8{1, 0, 0, 0, 0, 0, 0, 0}, Vec8{0, 1, 0, 0, 0, 0, 0, 0}, Vec8{0, 0, 1, 0, 0, 0, 0, 0}};
 
     DualQuat map(const glm::dvec3& p) const {
-        DualQuat z;
+        Vec8 z;  // an array, not component(z, index): a loop without a branch per coordinate
         for (int index = 0; index < 8; ++index)
-            component(z, index) = origin[index] + p.x * axes[0][index] + p.y * axes[1][index] + p.z * axes[2][index];
-        return z;
+            z[index] = origin[index] + p.x * axes[0][index] + p.y * axes[1][index] + p.z * axes[2][index];
+        return toDualQuat(z);
     }
 };
 
