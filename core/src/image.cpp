@@ -88,6 +88,9 @@ bool writePngRows(std::ostream* out, png_uint_32 width, png_uint_32 height, int 
     // zlib's fast match finder: a 640x480 render compresses 3-4x faster than at the default
     // level 6 (about 20 ms less, one thread, after a render of 0.1 s) for a file about 12% larger.
     png_set_compression_level(png, 2);
+    // One row filter, "up", instead of libpng's choice per row among all five, which cost as much
+    // as the compression (4 % of a 640x480 render's CPU): files within 1.5 % of the size.
+    png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_UP);
     png_write_info(png, info);
     png_write_image(png, rows);
     png_write_end(png, info);
