@@ -8,6 +8,10 @@
 // escapes. The packet engine runs the rays of a tile as a wavefront: each round the queries of
 // every unfinished ray go through the SIMD batch kernel together and finished rays retire. The
 // scalar engine answers each query with evaluate(), the reference; both run the same logic.
+// The packet engine uses the float kernel (twice the lanes) where its derivative cannot
+// overflow: the points it evaluates stay about a hit threshold (a fraction of a pixel) from
+// the surface or more, where the float orbit's error, 2^-24 times the derivative (batch.hpp),
+// moves the DE by a small fraction of that threshold.
 #include "dqjulia/render.hpp"
 #include "dqjulia/batch.hpp"
 #include "dqjulia/coloring.hpp"
@@ -22,6 +26,7 @@
 #include <cstdint>
 #include <limits>
 #include <numbers>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -140,6 +145,9 @@ public:
         stretch_ = stretchOf(slice_).max;
         footprint_ = 2.0 * camera_.tanHalfFov / camera_.height;
         samples_ = std::max(1, settings_.samples);
+        // The derivative before escape is at most (2 R)^N (each factor 2 |a_k| with |a_k| <= R):
+        // the float kernel only where that stays well below float's largest value, 2^128.
+        floatKernel_ = fractal_.iterations * std::log2(2.0 * std::max(fractal_.bailout, 1.0)) < 100.0;
         analytic_ = settings_.normals == NormalMethod::Analytic ||
                     (settings_.normals == NormalMethod::Auto && fractal_.variant == Variant::Dual);
         for (int axis = 0; axis < 3; ++axis) {
@@ -175,6 +183,8 @@ public:
 
     const Slice& slice() const { return slice_; }
     const Fractal& fractal() const { return fractal_; }
+    /// Whether the packet engine may evaluate in float (the derivative cannot overflow).
+    bool floatKernel() const { return floatKernel_; }
 
     glm::dvec3 baseColour(const Escape& escape) const { return orbitColour(material_, fractal_, escape); }
 
@@ -204,6 +214,7 @@ private:
     double stretch_ = 1.0;
     double footprint_ = 1e-3;
     int samples_ = 1;
+    bool floatKernel_ = false;
     bool analytic_ = false;
     Quat realAxes_[3];
     std::vector<ResolvedLight> lights_;
@@ -234,8 +245,8 @@ struct ShadowMarch {
 /// differences), the occlusion probes, and one soft-shadow march per lit light, side by side.
 /// The scalar engine answers each query at once with evaluate(); the packet engine gathers the
 /// queries of many rays and answers them together with the SIMD batch kernel (batch.hpp). Both
-/// run this same logic, so their pictures differ only by the kernel's rounding of the DE's
-/// logarithm.
+/// run this same logic, so their pictures differ only where the kernel's rounding (float, or the
+/// double kernel's logarithm) tips a decision.
 class RayJob {
 public:
     /// A camera ray; `start`: where a cone pre-pass proved the way free (0: from the bounds).
@@ -661,6 +672,17 @@ public:
             }
             return;
         }
+        if (scene.floatKernel()) {
+            runPackets(scene, jobs, floatBatch_);
+        } else {
+            runPackets(scene, jobs, batch_);
+        }
+    }
+
+private:
+    /// The packet engine with the kernel in T's precision.
+    template <typename T>
+    void runPackets(const Scene& scene, std::vector<RayJob>& jobs, BatchBuffer<T>& batch) {
         // Each job is visited once a round: it takes its answers and names its next queries at
         // once, into the other points buffer, while its state is at hand.
         active_.clear();
@@ -673,13 +695,13 @@ public:
         }
         while (!active_.empty()) {
             evaluations_ += points_.size();
-            evaluateBatch(scene);
+            evaluateBatch(scene, batch);
             nextPoints_.clear();
             std::size_t offset = 0;
             std::size_t kept = 0;
             for (std::size_t k = 0; k < active_.size(); ++k) {
                 RayJob& job = jobs[active_[k]];
-                job.answer(BatchEscapes{&batch_, offset});
+                job.answer(BatchEscapes<T>{&batch, offset});
                 offset += counts_[k];
                 if (job.done()) continue;
                 active_[kept] = active_[k];
@@ -691,17 +713,19 @@ public:
         }
     }
 
-private:
-    /// points_ -> batch_'s results through the SIMD kernel. The 8-D coordinates are Slice::map's
+    /// points_ -> `batch`'s results through the SIMD kernel. The 8-D coordinates are Slice::map's
     /// expression, coordinate by coordinate, so they round the same; terms with a zero axis
     /// component are left out (they add a zero, which changes at most the sign of a zero).
-    void evaluateBatch(const Scene& scene) {
+    template <typename T>
+    void evaluateBatch(const Scene& scene, BatchBuffer<T>& batch) {
         const std::size_t count = points_.size();
         const Slice& slice = scene.slice();
-        batch_.resize(count);
+        batch.resize(count);
         const glm::dvec3* points = points_.data();
+        if (constantsInFloat_ != std::is_same_v<T, float>) constants_.fill(0);  // the other buffer's
+        constantsInFloat_ = std::is_same_v<T, float>;
         for (int k = 0; k < 8; ++k) {
-            double* out = batch_.start(k);
+            T* out = batch.start(k);
             const double origin = slice.origin[k];
             // A coordinate the slice does not move (5 of 8 on the usual slices) keeps its value
             // from round to round: the kernel only reads the start points, so only the entries
@@ -721,7 +745,7 @@ private:
                 scales[terms++] = slice.axes[axis][k];
             }
             if (terms == 0) {
-                std::fill(out + constants_[k], out + count, origin);
+                std::fill(out + constants_[k], out + count, static_cast<T>(origin));
                 constants_[k] = count;
                 constantOrigin_[k] = origin;
                 continue;
@@ -729,25 +753,27 @@ private:
             constants_[k] = 0;
             switch (terms) {
                 case 1:
-                    for (std::size_t i = 0; i < count; ++i) out[i] = origin + points[i][axes[0]] * scales[0];
+                    for (std::size_t i = 0; i < count; ++i)
+                        out[i] = static_cast<T>(origin + points[i][axes[0]] * scales[0]);
                     break;
                 case 2:
                     for (std::size_t i = 0; i < count; ++i)
-                        out[i] = origin + points[i][axes[0]] * scales[0] + points[i][axes[1]] * scales[1];
+                        out[i] = static_cast<T>(origin + points[i][axes[0]] * scales[0] + points[i][axes[1]] * scales[1]);
                     break;
                 default:
                     for (std::size_t i = 0; i < count; ++i)
-                        out[i] = origin + points[i][axes[0]] * scales[0] + points[i][axes[1]] * scales[1] +
-                                 points[i][axes[2]] * scales[2];
+                        out[i] = static_cast<T>(origin + points[i][axes[0]] * scales[0] +
+                                                points[i][axes[1]] * scales[1] + points[i][axes[2]] * scales[2]);
                     break;
             }
         }
-        batch_.evaluate(scene.fractal());
+        batch.evaluate(scene.fractal());
     }
 
     /// The kernel's results from `first` on, read in place as Probes (RayJob::answer).
+    template <typename T>
     struct BatchEscapes {
-        const BatchBuffer<double>* batch;
+        const BatchBuffer<T>* batch;
         std::size_t first;
         Probe operator[](std::size_t i) const {
             const std::size_t j = first + i;
@@ -761,10 +787,12 @@ private:
     std::vector<std::size_t> counts_;
     std::vector<std::size_t> active_;
     BatchBuffer<double> batch_;
+    BatchBuffer<float> floatBatch_;
     // Per 8-D coordinate: how many leading start points hold constantOrigin_ (a coordinate the
     // slice does not move), still valid from the last round.
     std::array<std::size_t, 8> constants_{};
     std::array<double, 8> constantOrigin_{};
+    bool constantsInFloat_ = false;  // which buffer constants_ describes
     std::uint64_t evaluations_ = 0;
 };
 
