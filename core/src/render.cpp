@@ -190,9 +190,13 @@ public:
 
     /// Vertical gradient over the image: bottom colour at the bottom edge, top at the top.
     glm::dvec3 background(const glm::dvec3& direction) const {
-        const double height =
-            glm::dot(direction, camera_.up) / glm::dot(direction, camera_.forward) / camera_.tanHalfFov;
-        const double mix = std::clamp(0.5 + 0.5 * height, 0.0, 1.0);
+        return backgroundAt(glm::dot(direction, camera_.up) / glm::dot(direction, camera_.forward));
+    }
+    /// The same for the rays through the image plane's row at `y` (screenY()): the gradient
+    /// depends on the row only (equal to background() up to rounding), so a tile's pixels that
+    /// trace no ray take it per row, without a direction each.
+    glm::dvec3 backgroundAt(double y) const {
+        const double mix = std::clamp(0.5 + 0.5 * (y / camera_.tanHalfFov), 0.0, 1.0);
         return settings_.backgroundBottom * (1.0 - mix) + settings_.backgroundTop * mix;
     }
 
@@ -811,6 +815,7 @@ struct TileBuffers {
     std::vector<ShadowMarch> shadowSlots;  // the jobs' shadow marches (RayJob's `shadows`)
     std::vector<double> columnX;           // image plane x of the tile's sub-pixel columns
     std::vector<double> rowY;              // and y of its rows
+    std::vector<glm::dvec3> rowBackground; // and the background of each row
     std::vector<double> starts;            // per cone block: where its rays start (+inf: all miss)
     std::vector<std::size_t> firstJob;     // per pixel of the pass: its first job, or kNoJob
 };
@@ -842,6 +847,9 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
         for (int sx = 0; sx < samples; ++sx) columnX.push_back(screenX(camera, x + (sx + 0.5) / samples));
     for (int y = y0; y < y1; ++y)
         for (int sy = 0; sy < samples; ++sy) rowY.push_back(screenY(camera, y + (sy + 0.5) / samples));
+    std::vector<glm::dvec3>& rowBackground = buffers.rowBackground;  // the background of each row
+    rowBackground.clear();
+    for (const double y : rowY) rowBackground.push_back(scene.backgroundAt(y));
     auto sampleDirection = [&](int x, int y, int sx, int sy) {
         const int column = (x - x0) * samples + sx;
         const int row = (y - y0) * samples + sy;
@@ -939,7 +947,7 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
             const std::size_t pixelJobs = firstJob[static_cast<std::size_t>(index - first)];
             for (int sample = 0; sample < perPixel && pixelJobs == kNoJob; ++sample) {
                 ++stats.rays;  // the background, as a missing ray's job would give it
-                colour += scene.background(sampleDirection(x, y, sample % samples, sample / samples));
+                colour += rowBackground[static_cast<std::size_t>((y - y0) * samples + sample / samples)];
             }
             for (int sample = 0; sample < perPixel && pixelJobs != kNoJob; ++sample) {
                 const RayJob& job = jobs[pixelJobs + sample];
