@@ -120,6 +120,20 @@ struct Probe {
     }
 };
 
+/// 3-D points to evaluate, structure of arrays: mapping them to 8-D reads each coordinate
+/// contiguously (vectorised loops), not every third double.
+struct Points3 {
+    std::array<std::vector<double>, 3> coords;
+    std::size_t size() const { return coords[0].size(); }
+    void clear() {
+        for (auto& coordinate : coords) coordinate.clear();
+    }
+    void push_back(const glm::dvec3& p) {
+        for (int axis = 0; axis < 3; ++axis) coords[axis].push_back(p[axis]);
+    }
+    glm::dvec3 operator[](std::size_t i) const { return {coords[0][i], coords[1][i], coords[2][i]}; }
+};
+
 /// Result of marching one ray.
 struct Trace {
     bool hit = false;
@@ -317,7 +331,7 @@ public:
     const glm::dvec3& normal() const { return normal_; }
 
     /// Appends the points this ray needs evaluated next; returns how many (0 once done).
-    std::size_t queries(std::vector<glm::dvec3>& points) const {
+    std::size_t queries(Points3& points) const {
         const glm::dvec3& eye = scene_->camera_.eye;
         switch (stage_) {
             case Stage::March: points.push_back(eye + t_ * direction_); return 1;
@@ -670,7 +684,8 @@ public:
                     job.queries(points_);
                     evaluations_ += points_.size();
                     probes_.clear();
-                    for (const glm::dvec3& p : points_) probes_.push_back(Probe::of(scene.evaluateAt(p)));
+                    for (std::size_t i = 0; i < points_.size(); ++i)
+                        probes_.push_back(Probe::of(scene.evaluateAt(points_[i])));
                     job.answer(probes_.data());
                 }
             }
@@ -725,7 +740,7 @@ private:
         const std::size_t count = points_.size();
         const Slice& slice = scene.slice();
         batch.resize(count);
-        const glm::dvec3* points = points_.data();
+        const std::array<std::vector<double>, 3>& points = points_.coords;
         if (constantsInFloat_ != std::is_same_v<T, float>) constants_.fill(0);  // the other buffer's
         constantsInFloat_ = std::is_same_v<T, float>;
         for (int k = 0; k < 8; ++k) {
@@ -756,19 +771,23 @@ private:
             }
             constants_[k] = 0;
             switch (terms) {
-                case 1:
-                    for (std::size_t i = 0; i < count; ++i)
-                        out[i] = static_cast<T>(origin + points[i][axes[0]] * scales[0]);
+                case 1: {
+                    const double* p0 = points[axes[0]].data();
+                    for (std::size_t i = 0; i < count; ++i) out[i] = static_cast<T>(origin + p0[i] * scales[0]);
                     break;
-                case 2:
+                }
+                case 2: {
+                    const double *p0 = points[axes[0]].data(), *p1 = points[axes[1]].data();
                     for (std::size_t i = 0; i < count; ++i)
-                        out[i] = static_cast<T>(origin + points[i][axes[0]] * scales[0] + points[i][axes[1]] * scales[1]);
+                        out[i] = static_cast<T>(origin + p0[i] * scales[0] + p1[i] * scales[1]);
                     break;
-                default:
+                }
+                default: {
+                    const double *p0 = points[axes[0]].data(), *p1 = points[axes[1]].data(), *p2 = points[axes[2]].data();
                     for (std::size_t i = 0; i < count; ++i)
-                        out[i] = static_cast<T>(origin + points[i][axes[0]] * scales[0] +
-                                                points[i][axes[1]] * scales[1] + points[i][axes[2]] * scales[2]);
+                        out[i] = static_cast<T>(origin + p0[i] * scales[0] + p1[i] * scales[1] + p2[i] * scales[2]);
                     break;
+                }
             }
         }
         batch.evaluate(scene.fractal());
@@ -785,8 +804,8 @@ private:
         }
     };
 
-    std::vector<glm::dvec3> points_;
-    std::vector<glm::dvec3> nextPoints_;  // the next round's, filled while answering this one
+    Points3 points_;
+    Points3 nextPoints_;  // the next round's, filled while answering this one
     std::vector<Probe> probes_;           // the scalar engine's escapes
     std::vector<std::size_t> counts_;
     std::vector<std::size_t> active_;
