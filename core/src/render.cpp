@@ -122,16 +122,24 @@ struct Probe {
 
 /// 3-D points to evaluate, structure of arrays: mapping them to 8-D reads each coordinate
 /// contiguously (vectorised loops), not every third double.
-struct Points3 {
-    std::array<std::vector<double>, 3> coords;
-    std::size_t size() const { return coords[0].size(); }
-    void clear() {
-        for (auto& coordinate : coords) coordinate.clear();
-    }
+/// One count for the three arrays, which only grow: an append is one check and three stores.
+class Points3 {
+public:
+    std::size_t size() const { return count_; }
+    void clear() { count_ = 0; }
     void push_back(const glm::dvec3& p) {
-        for (int axis = 0; axis < 3; ++axis) coords[axis].push_back(p[axis]);
+        if (count_ == coords_[0].size())
+            for (auto& coordinate : coords_) coordinate.resize(std::max<std::size_t>(64, 2 * count_));
+        for (int axis = 0; axis < 3; ++axis) coords_[axis][count_] = p[axis];
+        ++count_;
     }
-    glm::dvec3 operator[](std::size_t i) const { return {coords[0][i], coords[1][i], coords[2][i]}; }
+    glm::dvec3 operator[](std::size_t i) const { return {coords_[0][i], coords_[1][i], coords_[2][i]}; }
+    /// Coordinate `axis` of every point (size() of them).
+    const double* coordinate(int axis) const { return coords_[axis].data(); }
+
+private:
+    std::array<std::vector<double>, 3> coords_;
+    std::size_t count_ = 0;
 };
 
 /// Result of marching one ray.
@@ -740,7 +748,7 @@ private:
         const std::size_t count = points_.size();
         const Slice& slice = scene.slice();
         batch.resize(count);
-        const std::array<std::vector<double>, 3>& points = points_.coords;
+        const double* points[3] = {points_.coordinate(0), points_.coordinate(1), points_.coordinate(2)};
         if (constantsInFloat_ != std::is_same_v<T, float>) constants_.fill(0);  // the other buffer's
         constantsInFloat_ = std::is_same_v<T, float>;
         for (int k = 0; k < 8; ++k) {
@@ -772,18 +780,18 @@ private:
             constants_[k] = 0;
             switch (terms) {
                 case 1: {
-                    const double* p0 = points[axes[0]].data();
+                    const double* p0 = points[axes[0]];
                     for (std::size_t i = 0; i < count; ++i) out[i] = static_cast<T>(origin + p0[i] * scales[0]);
                     break;
                 }
                 case 2: {
-                    const double *p0 = points[axes[0]].data(), *p1 = points[axes[1]].data();
+                    const double *p0 = points[axes[0]], *p1 = points[axes[1]];
                     for (std::size_t i = 0; i < count; ++i)
                         out[i] = static_cast<T>(origin + p0[i] * scales[0] + p1[i] * scales[1]);
                     break;
                 }
                 default: {
-                    const double *p0 = points[axes[0]].data(), *p1 = points[axes[1]].data(), *p2 = points[axes[2]].data();
+                    const double *p0 = points[axes[0]], *p1 = points[axes[1]], *p2 = points[axes[2]];
                     for (std::size_t i = 0; i < count; ++i)
                         out[i] = static_cast<T>(origin + p0[i] * scales[0] + p1[i] * scales[1] + p2[i] * scales[2]);
                     break;
