@@ -128,8 +128,7 @@ public:
     std::size_t size() const { return count_; }
     void clear() { count_ = 0; }
     void push_back(const glm::dvec3& p) {
-        if (count_ == coords_[0].size())
-            for (auto& coordinate : coords_) coordinate.resize(std::max<std::size_t>(64, 2 * count_));
+        if (count_ == coords_[0].size()) grow();
         for (int axis = 0; axis < 3; ++axis) coords_[axis][count_] = p[axis];
         ++count_;
     }
@@ -138,6 +137,11 @@ public:
     const double* coordinate(int axis) const { return coords_[axis].data(); }
 
 private:
+    // Out of line and rare, so that push_back stays small enough to inline into queries().
+    void grow() {
+        for (auto& coordinate : coords_) coordinate.resize(std::max<std::size_t>(64, 2 * count_));
+    }
+
     std::array<std::vector<double>, 3> coords_;
     std::size_t count_ = 0;
 };
