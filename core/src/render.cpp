@@ -817,7 +817,7 @@ private:
     };
 
     Points3 points_;
-    Points3 nextPoints_;  // the next round's, filled while answering this one
+    Points3 nextPoints_;                  // the next round's, filled while answering this one
     std::vector<Probe> probes_;           // the scalar engine's escapes
     std::vector<std::size_t> counts_;
     std::vector<std::size_t> active_;
@@ -846,7 +846,7 @@ struct TileBuffers {
     std::vector<ShadowMarch> shadowSlots;  // the jobs' shadow marches (RayJob's `shadows`)
     std::vector<double> columnX;           // image plane x of the tile's sub-pixel columns
     std::vector<double> rowY;              // and y of its rows
-    std::vector<glm::dvec3> rowBackground; // and the background of each row
+    std::vector<glm::dvec3> rowBackground;  // and the background of each row
     std::vector<double> starts;            // per cone block: where its rays start (+inf: all miss)
     std::vector<std::size_t> firstJob;     // per pixel of the pass: its first job, or kNoJob
 };
@@ -978,7 +978,7 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
             const std::size_t pixelJobs = firstJob[static_cast<std::size_t>(index - first)];
             for (int sample = 0; sample < perPixel && pixelJobs == kNoJob; ++sample) {
                 ++stats.rays;  // the background, as a missing ray's job would give it
-                colour += rowBackground[static_cast<std::size_t>((y - y0) * samples + sample / samples)];
+                colour += rowBackground[static_cast<std::size_t>(y - y0) * samples + sample / samples];
             }
             for (int sample = 0; sample < perPixel && pixelJobs != kNoJob; ++sample) {
                 const RayJob& job = jobs[pixelJobs + sample];
