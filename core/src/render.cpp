@@ -179,8 +179,7 @@ public:
         double largest = 0.0;
         for (int k = 0; k < 8; ++k)
             largest = std::max({largest, std::abs(slice_.origin[k]) + reach, std::abs(component(fractal_.c, k))});
-        floatKernel_ = fractal_.iterations * std::log2(2.0 * std::max(fractal_.bailout, 1.0)) < 100.0 &&
-                       largest < 1e15;
+        floatKernel_ = fractal_.iterations * std::log2(2.0 * std::max(fractal_.bailout, 1.0)) < 100.0 && largest < 1e15;
         analytic_ = settings_.normals == NormalMethod::Analytic ||
                     (settings_.normals == NormalMethod::Auto && fractal_.variant == Variant::Dual);
         for (int axis = 0; axis < 3; ++axis) {

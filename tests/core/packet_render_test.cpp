@@ -111,3 +111,15 @@ TEST(PacketRender, ClippedExtrusionAndNoOcclusionMatch) {
     params.render.samples = 1;
     expectSamePicture(params, "dual, slice along a dual axis (cut faces), no occlusion");
 }
+
+// N log2(2R) = 40 * 3 >= 100: the derivative could overflow float, so the packet engine takes
+// the double kernel (render.cpp, Scene::floatKernel) and must match as well.
+TEST(PacketRender, DeepIterationsTakeTheDoubleKernelAndMatch) {
+    Params params = smallParams();
+    params.fractal.variant = Variant::Dual;
+    params.fractal.c = DualQuat{makeQuat(-0.083, 0.0, -0.83, -0.025), makeQuat(0, 0, 0, 0)};
+    params.fractal.iterations = 40;
+    params.fractal.bailout = 4.0;
+    params.render.samples = 1;
+    expectSamePicture(params, "dual, N = 40, R = 4 (the double kernel)");
+}
