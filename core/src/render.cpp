@@ -8,6 +8,10 @@
 // escapes. The packet engine runs the rays of a tile as a wavefront: each round the queries of
 // every unfinished ray go through the SIMD batch kernel together and finished rays retire. The
 // scalar engine answers each query with evaluate(), the reference; both run the same logic.
+// The packet engine uses the float kernel (twice the lanes) where its derivative cannot
+// overflow: the points it evaluates stay about a hit threshold (a fraction of a pixel) from
+// the surface or more, where the float orbit's error, 2^-24 times the derivative (batch.hpp),
+// moves the DE by a small fraction of that threshold.
 #include "dqjulia/render.hpp"
 #include "dqjulia/batch.hpp"
 #include "dqjulia/coloring.hpp"
@@ -22,6 +26,7 @@
 #include <cstdint>
 #include <limits>
 #include <numbers>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -115,6 +120,32 @@ struct Probe {
     }
 };
 
+/// 3-D points to evaluate, structure of arrays: mapping them to 8-D reads each coordinate
+/// contiguously (vectorised loops), not every third double.
+/// One count for the three arrays, which only grow: an append is one check and three stores.
+class Points3 {
+public:
+    std::size_t size() const { return count_; }
+    void clear() { count_ = 0; }
+    void push_back(const glm::dvec3& p) {
+        if (count_ == coords_[0].size()) grow();
+        for (int axis = 0; axis < 3; ++axis) coords_[axis][count_] = p[axis];
+        ++count_;
+    }
+    glm::dvec3 operator[](std::size_t i) const { return {coords_[0][i], coords_[1][i], coords_[2][i]}; }
+    /// Coordinate `axis` of every point (size() of them).
+    const double* coordinate(int axis) const { return coords_[axis].data(); }
+
+private:
+    // Out of line and rare, so that push_back stays small enough to inline into queries().
+    void grow() {
+        for (auto& coordinate : coords_) coordinate.resize(std::max<std::size_t>(64, 2 * count_));
+    }
+
+    std::array<std::vector<double>, 3> coords_;
+    std::size_t count_ = 0;
+};
+
 /// Result of marching one ray.
 struct Trace {
     bool hit = false;
@@ -140,6 +171,15 @@ public:
         stretch_ = stretchOf(slice_).max;
         footprint_ = 2.0 * camera_.tanHalfFov / camera_.height;
         samples_ = std::max(1, settings_.samples);
+        // The derivative before escape is at most (2 R)^N (each factor 2 |a_k| with |a_k| <= R):
+        // the float kernel only where that stays well below float's largest value, 2^128, and
+        // where the start points, c and their squares do too (an infinite square gives NaNs,
+        // which never escape: a false hit).
+        const double reach = stretch_ * (glm::length(bounds_.center) + bounds_.radius);  // of any point, in 8-D
+        double largest = 0.0;
+        for (int k = 0; k < 8; ++k)
+            largest = std::max({largest, std::abs(slice_.origin[k]) + reach, std::abs(component(fractal_.c, k))});
+        floatKernel_ = fractal_.iterations * std::log2(2.0 * std::max(fractal_.bailout, 1.0)) < 100.0 && largest < 1e15;
         analytic_ = settings_.normals == NormalMethod::Analytic ||
                     (settings_.normals == NormalMethod::Auto && fractal_.variant == Variant::Dual);
         for (int axis = 0; axis < 3; ++axis) {
@@ -175,14 +215,20 @@ public:
 
     const Slice& slice() const { return slice_; }
     const Fractal& fractal() const { return fractal_; }
+    /// Whether the packet engine may evaluate in float (the derivative cannot overflow).
+    bool floatKernel() const { return floatKernel_; }
 
     glm::dvec3 baseColour(const Escape& escape) const { return orbitColour(material_, fractal_, escape); }
 
     /// Vertical gradient over the image: bottom colour at the bottom edge, top at the top.
     glm::dvec3 background(const glm::dvec3& direction) const {
-        const double height =
-            glm::dot(direction, camera_.up) / glm::dot(direction, camera_.forward) / camera_.tanHalfFov;
-        const double mix = std::clamp(0.5 + 0.5 * height, 0.0, 1.0);
+        return backgroundAt(glm::dot(direction, camera_.up) / glm::dot(direction, camera_.forward));
+    }
+    /// The same for the rays through the image plane's row at `y` (screenY()): the gradient
+    /// depends on the row only (equal to background() up to rounding), so a tile's pixels that
+    /// trace no ray take it per row, without a direction each.
+    glm::dvec3 backgroundAt(double y) const {
+        const double mix = std::clamp(0.5 + 0.5 * (y / camera_.tanHalfFov), 0.0, 1.0);
         return settings_.backgroundBottom * (1.0 - mix) + settings_.backgroundTop * mix;
     }
 
@@ -204,6 +250,7 @@ private:
     double stretch_ = 1.0;
     double footprint_ = 1e-3;
     int samples_ = 1;
+    bool floatKernel_ = false;
     bool analytic_ = false;
     Quat realAxes_[3];
     std::vector<ResolvedLight> lights_;
@@ -234,8 +281,8 @@ struct ShadowMarch {
 /// differences), the occlusion probes, and one soft-shadow march per lit light, side by side.
 /// The scalar engine answers each query at once with evaluate(); the packet engine gathers the
 /// queries of many rays and answers them together with the SIMD batch kernel (batch.hpp). Both
-/// run this same logic, so their pictures differ only by the kernel's rounding of the DE's
-/// logarithm.
+/// run this same logic, so their pictures differ only where the kernel's rounding (float, or the
+/// double kernel's logarithm) tips a decision.
 class RayJob {
 public:
     /// A camera ray; `start`: where a cone pre-pass proved the way free (0: from the bounds).
@@ -302,7 +349,7 @@ public:
     const glm::dvec3& normal() const { return normal_; }
 
     /// Appends the points this ray needs evaluated next; returns how many (0 once done).
-    std::size_t queries(std::vector<glm::dvec3>& points) const {
+    std::size_t queries(Points3& points) const {
         const glm::dvec3& eye = scene_->camera_.eye;
         switch (stage_) {
             case Stage::March: points.push_back(eye + t_ * direction_); return 1;
@@ -655,12 +702,24 @@ public:
                     job.queries(points_);
                     evaluations_ += points_.size();
                     probes_.clear();
-                    for (const glm::dvec3& p : points_) probes_.push_back(Probe::of(scene.evaluateAt(p)));
+                    for (std::size_t i = 0; i < points_.size(); ++i)
+                        probes_.push_back(Probe::of(scene.evaluateAt(points_[i])));
                     job.answer(probes_.data());
                 }
             }
             return;
         }
+        if (scene.floatKernel()) {
+            runPackets(scene, jobs, floatBatch_);
+        } else {
+            runPackets(scene, jobs, batch_);
+        }
+    }
+
+private:
+    /// The packet engine with the kernel in T's precision.
+    template <typename T>
+    void runPackets(const Scene& scene, std::vector<RayJob>& jobs, BatchBuffer<T>& batch) {
         // Each job is visited once a round: it takes its answers and names its next queries at
         // once, into the other points buffer, while its state is at hand.
         active_.clear();
@@ -673,13 +732,13 @@ public:
         }
         while (!active_.empty()) {
             evaluations_ += points_.size();
-            evaluateBatch(scene);
+            evaluateBatch(scene, batch);
             nextPoints_.clear();
             std::size_t offset = 0;
             std::size_t kept = 0;
             for (std::size_t k = 0; k < active_.size(); ++k) {
                 RayJob& job = jobs[active_[k]];
-                job.answer(BatchEscapes{&batch_, offset});
+                job.answer(BatchEscapes<T>{&batch, offset});
                 offset += counts_[k];
                 if (job.done()) continue;
                 active_[kept] = active_[k];
@@ -691,17 +750,19 @@ public:
         }
     }
 
-private:
-    /// points_ -> batch_'s results through the SIMD kernel. The 8-D coordinates are Slice::map's
+    /// points_ -> `batch`'s results through the SIMD kernel. The 8-D coordinates are Slice::map's
     /// expression, coordinate by coordinate, so they round the same; terms with a zero axis
     /// component are left out (they add a zero, which changes at most the sign of a zero).
-    void evaluateBatch(const Scene& scene) {
+    template <typename T>
+    void evaluateBatch(const Scene& scene, BatchBuffer<T>& batch) {
         const std::size_t count = points_.size();
         const Slice& slice = scene.slice();
-        batch_.resize(count);
-        const glm::dvec3* points = points_.data();
+        batch.resize(count);
+        const double* points[3] = {points_.coordinate(0), points_.coordinate(1), points_.coordinate(2)};
+        if (constantsInFloat_ != std::is_same_v<T, float>) constants_.fill(0);  // the other buffer's
+        constantsInFloat_ = std::is_same_v<T, float>;
         for (int k = 0; k < 8; ++k) {
-            double* out = batch_.start(k);
+            T* out = batch.start(k);
             const double origin = slice.origin[k];
             // A coordinate the slice does not move (5 of 8 on the usual slices) keeps its value
             // from round to round: the kernel only reads the start points, so only the entries
@@ -721,33 +782,39 @@ private:
                 scales[terms++] = slice.axes[axis][k];
             }
             if (terms == 0) {
-                std::fill(out + constants_[k], out + count, origin);
+                std::fill(out + constants_[k], out + count, static_cast<T>(origin));
                 constants_[k] = count;
                 constantOrigin_[k] = origin;
                 continue;
             }
             constants_[k] = 0;
             switch (terms) {
-                case 1:
-                    for (std::size_t i = 0; i < count; ++i) out[i] = origin + points[i][axes[0]] * scales[0];
+                case 1: {
+                    const double* p0 = points[axes[0]];
+                    for (std::size_t i = 0; i < count; ++i) out[i] = static_cast<T>(origin + p0[i] * scales[0]);
                     break;
-                case 2:
+                }
+                case 2: {
+                    const double *p0 = points[axes[0]], *p1 = points[axes[1]];
                     for (std::size_t i = 0; i < count; ++i)
-                        out[i] = origin + points[i][axes[0]] * scales[0] + points[i][axes[1]] * scales[1];
+                        out[i] = static_cast<T>(origin + p0[i] * scales[0] + p1[i] * scales[1]);
                     break;
-                default:
+                }
+                default: {
+                    const double *p0 = points[axes[0]], *p1 = points[axes[1]], *p2 = points[axes[2]];
                     for (std::size_t i = 0; i < count; ++i)
-                        out[i] = origin + points[i][axes[0]] * scales[0] + points[i][axes[1]] * scales[1] +
-                                 points[i][axes[2]] * scales[2];
+                        out[i] = static_cast<T>(origin + p0[i] * scales[0] + p1[i] * scales[1] + p2[i] * scales[2]);
                     break;
+                }
             }
         }
-        batch_.evaluate(scene.fractal());
+        batch.evaluate(scene.fractal());
     }
 
     /// The kernel's results from `first` on, read in place as Probes (RayJob::answer).
+    template <typename T>
     struct BatchEscapes {
-        const BatchBuffer<double>* batch;
+        const BatchBuffer<T>* batch;
         std::size_t first;
         Probe operator[](std::size_t i) const {
             const std::size_t j = first + i;
@@ -755,16 +822,18 @@ private:
         }
     };
 
-    std::vector<glm::dvec3> points_;
-    std::vector<glm::dvec3> nextPoints_;  // the next round's, filled while answering this one
+    Points3 points_;
+    Points3 nextPoints_;                  // the next round's, filled while answering this one
     std::vector<Probe> probes_;           // the scalar engine's escapes
     std::vector<std::size_t> counts_;
     std::vector<std::size_t> active_;
     BatchBuffer<double> batch_;
+    BatchBuffer<float> floatBatch_;
     // Per 8-D coordinate: how many leading start points hold constantOrigin_ (a coordinate the
     // slice does not move), still valid from the last round.
     std::array<std::size_t, 8> constants_{};
     std::array<double, 8> constantOrigin_{};
+    bool constantsInFloat_ = false;  // which buffer constants_ describes
     std::uint64_t evaluations_ = 0;
 };
 
@@ -783,6 +852,7 @@ struct TileBuffers {
     std::vector<ShadowMarch> shadowSlots;  // the jobs' shadow marches (RayJob's `shadows`)
     std::vector<double> columnX;           // image plane x of the tile's sub-pixel columns
     std::vector<double> rowY;              // and y of its rows
+    std::vector<glm::dvec3> rowBackground;  // and the background of each row
     std::vector<double> starts;            // per cone block: where its rays start (+inf: all miss)
     std::vector<std::size_t> firstJob;     // per pixel of the pass: its first job, or kNoJob
 };
@@ -814,6 +884,9 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
         for (int sx = 0; sx < samples; ++sx) columnX.push_back(screenX(camera, x + (sx + 0.5) / samples));
     for (int y = y0; y < y1; ++y)
         for (int sy = 0; sy < samples; ++sy) rowY.push_back(screenY(camera, y + (sy + 0.5) / samples));
+    std::vector<glm::dvec3>& rowBackground = buffers.rowBackground;  // the background of each row
+    rowBackground.clear();
+    for (const double y : rowY) rowBackground.push_back(scene.backgroundAt(y));
     auto sampleDirection = [&](int x, int y, int sx, int sy) {
         const int column = (x - x0) * samples + sx;
         const int row = (y - y0) * samples + sy;
@@ -911,7 +984,7 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
             const std::size_t pixelJobs = firstJob[static_cast<std::size_t>(index - first)];
             for (int sample = 0; sample < perPixel && pixelJobs == kNoJob; ++sample) {
                 ++stats.rays;  // the background, as a missing ray's job would give it
-                colour += scene.background(sampleDirection(x, y, sample % samples, sample / samples));
+                colour += rowBackground[static_cast<std::size_t>(y - y0) * samples + sample / samples];
             }
             for (int sample = 0; sample < perPixel && pixelJobs != kNoJob; ++sample) {
                 const RayJob& job = jobs[pixelJobs + sample];
