@@ -877,6 +877,7 @@ struct TileBuffers {
     std::vector<double> columnX;           // image plane x of the tile's sub-pixel columns
     std::vector<double> rowY;              // and y of its rows
     std::vector<glm::dvec3> rowBackground;  // and the background of each row
+    std::vector<glm::dvec3> pixelBackground;  // per pixel row: a pixel's colour if no sample hits
     std::vector<double> starts;            // per cone block: where its rays start (+inf: all miss)
     std::vector<std::size_t> firstJob;     // per pixel of the pass: its first job, or kNoJob
 };
@@ -911,6 +912,16 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
     std::vector<glm::dvec3>& rowBackground = buffers.rowBackground;  // the background of each row
     rowBackground.clear();
     for (const double y : rowY) rowBackground.push_back(scene.backgroundAt(y));
+    // What a pixel whose cone misses comes to, per pixel row: its samples' backgrounds summed
+    // and weighted as its rays' colours would be (the same sums), worked out once a row.
+    std::vector<glm::dvec3>& pixelBackground = buffers.pixelBackground;
+    pixelBackground.clear();
+    for (int y = y0; y < y1; ++y) {
+        glm::dvec3 colour(0.0);
+        for (int sample = 0; sample < perPixel; ++sample)
+            colour += rowBackground[static_cast<std::size_t>(y - y0) * samples + sample / samples];
+        pixelBackground.push_back(colour * weight);
+    }
     auto sampleDirection = [&](int x, int y, int sx, int sy) {
         const int column = (x - x0) * samples + sx;
         const int row = (y - y0) * samples + sy;
@@ -1000,17 +1011,26 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
         for (int index = first; index < last; ++index) {
             const int x = x0 + index % width;
             const int y = y0 + index / width;
+            const std::size_t pixel = static_cast<std::size_t>(y) * image.width + x;
+            const std::size_t pixelJobs = firstJob[static_cast<std::size_t>(index - first)];
+            if (pixelJobs == kNoJob) {  // the background, as its rays' jobs would give it
+                stats.rays += perPixel;
+                const glm::dvec3& colour = pixelBackground[static_cast<std::size_t>(y - y0)];
+                std::fill_n(image.surface.begin() + 3 * pixel, 3, 0.0f);
+                image.rgba[4 * pixel + 0] = static_cast<float>(colour.x);
+                image.rgba[4 * pixel + 1] = static_cast<float>(colour.y);
+                image.rgba[4 * pixel + 2] = static_cast<float>(colour.z);
+                image.rgba[4 * pixel + 3] = 0.0f;
+                image.depth[pixel] = std::numeric_limits<float>::infinity();
+                std::fill_n(image.normal.begin() + 3 * pixel, 3, 0.0f);
+                continue;
+            }
             glm::dvec3 colour(0.0);
             glm::dvec3 surfaceColour(0.0);
             glm::dvec3 normalSum(0.0);
             double depth = kInfinity;
             int hits = 0;
-            const std::size_t pixelJobs = firstJob[static_cast<std::size_t>(index - first)];
-            for (int sample = 0; sample < perPixel && pixelJobs == kNoJob; ++sample) {
-                ++stats.rays;  // the background, as a missing ray's job would give it
-                colour += rowBackground[static_cast<std::size_t>(y - y0) * samples + sample / samples];
-            }
-            for (int sample = 0; sample < perPixel && pixelJobs != kNoJob; ++sample) {
+            for (int sample = 0; sample < perPixel; ++sample) {
                 const RayJob& job = jobs[pixelJobs + sample];
                 ++stats.rays;
                 stats.steps += job.trace().steps;
@@ -1021,7 +1041,6 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
                 depth = std::min(depth, job.trace().t);
                 ++hits;
             }
-            const std::size_t pixel = static_cast<std::size_t>(y) * image.width + x;
             colour *= weight;
             surfaceColour *= weight;
             for (int channel = 0; channel < 3; ++channel)
