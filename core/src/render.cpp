@@ -208,10 +208,8 @@ public:
     Escape evaluateAt(const glm::dvec3& p) const { return evaluate(fractal_, slice_.map(p)); }
 
     /// The DE as a 3-D distance; 0 inside, +inf for a zero derivative.
-    template <class Result>  // Escape or Probe
-    double distance3(const Result& escape) const {
-        return escape.n == 0 ? 0.0 : escape.de / stretch_;
-    }
+    double distance3(int n, double de) const { return n == 0 ? 0.0 : de / stretch_; }
+    double distance3(const Probe& escape) const { return distance3(escape.n, escape.de); }
 
     const Slice& slice() const { return slice_; }
     const Fractal& fractal() const { return fractal_; }
@@ -352,7 +350,8 @@ public:
     std::size_t queries(Points3& points) const {
         const glm::dvec3& eye = scene_->camera_.eye;
         switch (stage_) {
-            case Stage::March: points.push_back(eye + t_ * direction_); return 1;
+            case Stage::March:
+            case Stage::Recall: points.push_back(eye + t_ * direction_); return 1;
             case Stage::Bisect: points.push_back(eye + 0.5 * (outside_ + inside_) * direction_); return 1;
             case Stage::Normal:
                 for (int axis = 0; axis < 3; ++axis) {
@@ -384,13 +383,18 @@ public:
     }
 
     /// Takes the escapes of the points the last queries() named, in order, and moves on.
-    /// `escapes[i]`: the Probe of the i-th point (a Probe array, or a view of the batch kernel's
-    /// results read in place).
+    /// `escapes[i]`: the Probe of the i-th point; `escapes.n(i)`, `escapes.de(i)`: its count and
+    /// DE alone, all that most stages read (a view of Probes, or of the batch kernel's results
+    /// read in place: no six fields converted where two are needed).
     template <class Escapes>
     void answer(const Escapes& escapes) {
         switch (stage_) {
-            case Stage::March: answerMarch(escapes[0]); return;
+            case Stage::March: answerMarch(escapes); return;
             case Stage::Bisect: answerBisect(escapes[0]); return;
+            case Stage::Recall:
+                trace_.escape = escapes[0];
+                finishMarch();
+                return;
             case Stage::Normal: answerNormal(escapes); return;
             case Stage::Occlusion: answerOcclusion(escapes); return;
             case Stage::Shadows: answerShadows(escapes); return;
@@ -400,23 +404,24 @@ public:
     }
 
 private:
-    enum class Stage { March, Bisect, Normal, Occlusion, Shadows, Paused, Done };
+    enum class Stage { March, Bisect, Recall, Normal, Occlusion, Shadows, Paused, Done };
 
     /// Sphere tracing: step by stepFactor * min(DE / stretch, maxStep) until the DE is below
     /// the hit threshold or the ray leaves the bounds.
-    void answerMarch(const Probe& escape) {
+    template <class Escapes>
+    void answerMarch(const Escapes& escapes) {
         if (cone_) {
-            answerCone(escape);
+            answerCone(escapes.n(0), escapes.de(0));
             return;
         }
         const RenderSettings& settings = scene_->settings_;
         ++trace_.steps;
-        eps_ = scene_->epsilon(t_);
-        if (escape.n == 0) {
+        const double eps = scene_->epsilon(t_);
+        if (escapes.n(0) == 0) {
             trace_.hit = true;
             if (!havePrevious_) {
                 trace_.t = t_;
-                trace_.escape = escape;
+                trace_.escape = escapes[0];
                 trace_.cutFace = step_ == 0 && !seeded_ && scene_->bounds_.clipped && span_.near > 0.0;
                 finishMarch();
                 return;
@@ -428,29 +433,29 @@ private:
             stage_ = Stage::Bisect;
             return;
         }
-        step3_ = escape.de / scene_->stretch_;
-        if (!std::isfinite(step3_)) step3_ = settings.maxStep;  // zero derivative: largest step
-        if (step3_ < eps_) {
+        double step3 = escapes.de(0) / scene_->stretch_;
+        if (!std::isfinite(step3)) step3 = settings.maxStep;  // zero derivative: largest step
+        if (step3 < eps) {
             trace_.hit = true;
             trace_.t = t_;
-            trace_.escape = escape;
+            trace_.escape = escapes[0];
             finishMarch();
             return;
         }
+        // Only the last point's t is kept, not its escape (six fields copied every step): the
+        // rare hits that need it (recall()) evaluate that point again, to the same result.
         previousT_ = t_;
-        previous_ = escape;
         havePrevious_ = true;
-        t_ += settings.stepFactor * std::min(step3_, settings.maxStep);
+        t_ += settings.stepFactor * std::min(step3, settings.maxStep);
         if (t_ > span_.far) {
             finishMarch();
             return;
         }
         if (++step_ == settings.maxSteps) {
             // Out of steps: close enough to count, or give up.
-            if (step3_ < 10.0 * eps_) {
-                trace_.hit = true;
-                trace_.t = previousT_;
-                trace_.escape = previous_;
+            if (step3 < 10.0 * eps) {
+                recall(previousT_);
+                return;
             }
             finishMarch();
         }
@@ -459,13 +464,13 @@ private:
     /// Cone marching (the pre-pass): every ray of the cone lies within spread * t of the axis,
     /// so the ball of radius DE around the axis point keeps it free for a step of
     /// (DE - spread * t) / (1 + spread), with the rays' step factor and largest step.
-    void answerCone(const Probe& escape) {
+    void answerCone(int n, double de) {
         const RenderSettings& settings = scene_->settings_;
-        double free = scene_->distance3(escape);
+        double free = scene_->distance3(n, de);
         if (!std::isfinite(free)) free = settings.maxStep;  // zero derivative: as the rays do
         free -= spread_ * t_;
         coneStart_ = t_;
-        if (escape.n == 0 || free < kConeMargin * scene_->epsilon(t_) || ++step_ == settings.maxSteps) {
+        if (n == 0 || free < kConeMargin * scene_->epsilon(t_) || ++step_ == settings.maxSteps) {
             stage_ = Stage::Done;
             return;
         }
@@ -483,13 +488,25 @@ private:
             inside_ = middle;
         } else {
             outside_ = middle;
-            previous_ = probe;
+            trace_.escape = probe;
+            bisectedOut_ = true;
         }
         if (++bisection_ == kBisectionSteps) {
+            if (!bisectedOut_) {
+                recall(outside_);  // every halving landed inside: the hit is the march's last point
+                return;
+            }
             trace_.t = outside_;
-            trace_.escape = previous_;
             finishMarch();
         }
+    }
+
+    /// A hit at `t`, a point the march evaluated before: its escape again (the same point gives
+    /// the same result), then the normal.
+    void recall(double t) {
+        trace_.hit = true;
+        trace_.t = t_ = t;
+        stage_ = Stage::Recall;
     }
 
     /// A miss takes the background; a hit goes on to its normal.
@@ -519,15 +536,14 @@ private:
         const double here = scene_->distance3(trace_.escape);
         glm::dvec3 gradient(0.0);
         for (int axis = 0; axis < 3; ++axis) {
-            const Probe& plus = probes[2 * axis];
-            const Probe& minus = probes[2 * axis + 1];
-            const double dPlus = scene_->distance3(plus);
-            const double dMinus = scene_->distance3(minus);
-            if (plus.n != 0 && minus.n != 0) {
+            const int plus = probes.n(2 * axis), minus = probes.n(2 * axis + 1);
+            const double dPlus = scene_->distance3(plus, probes.de(2 * axis));
+            const double dMinus = scene_->distance3(minus, probes.de(2 * axis + 1));
+            if (plus != 0 && minus != 0) {
                 gradient[axis] = (dPlus - dMinus) / (2.0 * h_);
-            } else if (plus.n != 0) {
+            } else if (plus != 0) {
                 gradient[axis] = (dPlus - here) / h_;
-            } else if (minus.n != 0) {
+            } else if (minus != 0) {
                 gradient[axis] = (here - dMinus) / h_;
             }
         }
@@ -567,7 +583,7 @@ private:
         double totalWeight = 0.0;
         for (int i = 1; i <= kOcclusionSamples; ++i, weight *= 0.5) {
             const double height = i * scene_->occlusionDelta_;
-            const double free = std::min(2.0 * scene_->distance3(probes[i - 1]), height);
+            const double free = std::min(2.0 * scene_->distance3(probes.n(i - 1), probes.de(i - 1)), height);
             sum += weight * (height - free) / height;
             totalWeight += weight;
         }
@@ -607,10 +623,10 @@ private:
         for (std::size_t index = 0; index < scene.lights_.size(); ++index) {
             ShadowMarch& shadow = shadows_[index];
             if (shadow.done) continue;
-            const Probe& escape = escapes[next++];
-            double d = escape.de / scene.stretch_;
+            const int n = escapes.n(next);
+            double d = escapes.de(next++) / scene.stretch_;
             if (!std::isfinite(d)) d = scene.settings_.maxStep;
-            const bool blocked = escape.n == 0 || d < 0.25 * hitEps_;
+            const bool blocked = n == 0 || d < 0.25 * hitEps_;
             if (shadow.relaxed && (blocked || shadow.t - shadow.previousT > shadow.previousD + d)) {
                 // The long step may have passed an occluder (its free ball and the last one do
                 // not overlap, or it landed on the set): take the plain step from the last point.
@@ -666,10 +682,8 @@ private:
     Interval span_;
     double t_ = 0.0;
     double previousT_ = 0.0;
-    double step3_ = kInfinity;
-    double eps_ = 0.0;
-    Probe previous_;
     bool havePrevious_ = false;
+    bool bisectedOut_ = false;  // a halving landed outside: trace_.escape holds its escape
     int step_ = 0;
     double outside_ = 0.0;
     double inside_ = 0.0;
@@ -704,7 +718,7 @@ public:
                     probes_.clear();
                     for (std::size_t i = 0; i < points_.size(); ++i)
                         probes_.push_back(Probe::of(scene.evaluateAt(points_[i])));
-                    job.answer(probes_.data());
+                    job.answer(ProbeEscapes{probes_.data()});
                 }
             }
             return;
@@ -811,7 +825,15 @@ private:
         batch.evaluate(scene.fractal());
     }
 
-    /// The kernel's results from `first` on, read in place as Probes (RayJob::answer).
+    /// The scalar engine's escapes, as RayJob::answer reads them.
+    struct ProbeEscapes {
+        const Probe* probes;
+        const Probe& operator[](std::size_t i) const { return probes[i]; }
+        int n(std::size_t i) const { return probes[i].n; }
+        double de(std::size_t i) const { return probes[i].de; }
+    };
+
+    /// The kernel's results from `first` on, read in place (RayJob::answer).
     template <typename T>
     struct BatchEscapes {
         const BatchBuffer<T>* batch;
@@ -820,6 +842,8 @@ private:
             const std::size_t j = first + i;
             return {batch->n(j), batch->r(j), batch->ra(j), batch->rb(j), batch->de(j), batch->trap(j)};
         }
+        int n(std::size_t i) const { return batch->n(first + i); }
+        double de(std::size_t i) const { return batch->de(first + i); }
     };
 
     Points3 points_;
@@ -853,6 +877,7 @@ struct TileBuffers {
     std::vector<double> columnX;           // image plane x of the tile's sub-pixel columns
     std::vector<double> rowY;              // and y of its rows
     std::vector<glm::dvec3> rowBackground;  // and the background of each row
+    std::vector<glm::dvec3> pixelBackground;  // per pixel row: a pixel's colour if no sample hits
     std::vector<double> starts;            // per cone block: where its rays start (+inf: all miss)
     std::vector<std::size_t> firstJob;     // per pixel of the pass: its first job, or kNoJob
 };
@@ -887,6 +912,16 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
     std::vector<glm::dvec3>& rowBackground = buffers.rowBackground;  // the background of each row
     rowBackground.clear();
     for (const double y : rowY) rowBackground.push_back(scene.backgroundAt(y));
+    // What a pixel whose cone misses comes to, per pixel row: its samples' backgrounds summed
+    // and weighted as its rays' colours would be (the same sums), worked out once a row.
+    std::vector<glm::dvec3>& pixelBackground = buffers.pixelBackground;
+    pixelBackground.clear();
+    for (int y = y0; y < y1; ++y) {
+        glm::dvec3 colour(0.0);
+        for (int sample = 0; sample < perPixel; ++sample)
+            colour += rowBackground[static_cast<std::size_t>(y - y0) * samples + sample / samples];
+        pixelBackground.push_back(colour * weight);
+    }
     auto sampleDirection = [&](int x, int y, int sx, int sy) {
         const int column = (x - x0) * samples + sx;
         const int row = (y - y0) * samples + sy;
@@ -976,17 +1011,26 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
         for (int index = first; index < last; ++index) {
             const int x = x0 + index % width;
             const int y = y0 + index / width;
+            const std::size_t pixel = static_cast<std::size_t>(y) * image.width + x;
+            const std::size_t pixelJobs = firstJob[static_cast<std::size_t>(index - first)];
+            if (pixelJobs == kNoJob) {  // the background, as its rays' jobs would give it
+                stats.rays += perPixel;
+                const glm::dvec3& colour = pixelBackground[static_cast<std::size_t>(y - y0)];
+                std::fill_n(image.surface.begin() + 3 * pixel, 3, 0.0f);
+                image.rgba[4 * pixel + 0] = static_cast<float>(colour.x);
+                image.rgba[4 * pixel + 1] = static_cast<float>(colour.y);
+                image.rgba[4 * pixel + 2] = static_cast<float>(colour.z);
+                image.rgba[4 * pixel + 3] = 0.0f;
+                image.depth[pixel] = std::numeric_limits<float>::infinity();
+                std::fill_n(image.normal.begin() + 3 * pixel, 3, 0.0f);
+                continue;
+            }
             glm::dvec3 colour(0.0);
             glm::dvec3 surfaceColour(0.0);
             glm::dvec3 normalSum(0.0);
             double depth = kInfinity;
             int hits = 0;
-            const std::size_t pixelJobs = firstJob[static_cast<std::size_t>(index - first)];
-            for (int sample = 0; sample < perPixel && pixelJobs == kNoJob; ++sample) {
-                ++stats.rays;  // the background, as a missing ray's job would give it
-                colour += rowBackground[static_cast<std::size_t>(y - y0) * samples + sample / samples];
-            }
-            for (int sample = 0; sample < perPixel && pixelJobs != kNoJob; ++sample) {
+            for (int sample = 0; sample < perPixel; ++sample) {
                 const RayJob& job = jobs[pixelJobs + sample];
                 ++stats.rays;
                 stats.steps += job.trace().steps;
@@ -997,7 +1041,6 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
                 depth = std::min(depth, job.trace().t);
                 ++hits;
             }
-            const std::size_t pixel = static_cast<std::size_t>(y) * image.width + x;
             colour *= weight;
             surfaceColour *= weight;
             for (int channel = 0; channel < 3; ++channel)

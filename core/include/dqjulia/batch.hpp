@@ -77,30 +77,35 @@ DQJ_API void evaluateBatch(const Fractal& fractal, const PointBatch<float>& poin
                            std::int64_t target = 0);
 
 /// A batch that owns its arrays: add() points, evaluate(), read the results back by index.
-/// Reuse one per thread: clear() keeps the memory.
+/// Reuse one per thread: clear() keeps the memory. The arrays only grow and the batch's length
+/// is kept apart, so a batch that grows again after a smaller one (the renderer's rounds) zeroes
+/// nothing: entries past the length hold stale values.
 template <typename T>
 class BatchBuffer {
 public:
-    std::size_t size() const { return start_[0].size(); }
-    void clear() {
-        for (auto& coordinate : start_) coordinate.clear();
-    }
+    std::size_t size() const { return count_; }
+    void clear() { count_ = 0; }
     /// Appends a start point; returns its index.
     std::size_t add(const DualQuat& z) {
+        if (count_ == start_[0].size()) grow(2 * count_ + 64);
         const Vec8 coordinates = toVec8(z);  // unrolled there: no branch on k per coordinate here
-        for (int k = 0; k < 8; ++k) start_[k].push_back(static_cast<T>(coordinates[k]));
-        return size() - 1;
+        for (int k = 0; k < 8; ++k) start_[k][count_] = static_cast<T>(coordinates[k]);
+        return count_++;
     }
-    /// Makes room for `count` start points, to be written through start(k) (faster than add()).
+    /// Makes `count` start points, to be written through start(k) (faster than add()); the
+    /// first min(count, size()) keep their values, the others are unspecified.
     void resize(std::size_t count) {
-        for (auto& coordinate : start_) coordinate.resize(count);
+        if (count > start_[0].size()) grow(count);
+        count_ = count;
     }
     /// Coordinate k (0..3 = a's s, i, j, k; 4..7 = b's) of every start point.
     T* start(int k) { return start_[k].data(); }
     void evaluate(const Fractal& fractal, std::int64_t target = 0) {
         const std::size_t count = size();
-        n_.resize(count);
-        for (auto* field : {&r_, &ra_, &rb_, &de_, &trap_}) field->resize(count);
+        if (n_.size() < count) {
+            n_.resize(count);
+            for (auto* field : {&r_, &ra_, &rb_, &de_, &trap_}) field->resize(count);
+        }
         PointBatch<T> points;
         for (int k = 0; k < 8; ++k) points.coords[k] = start_[k].data();
         points.count = count;
@@ -126,9 +131,14 @@ public:
     T trap(std::size_t index) const { return trap_[index]; }
 
 private:
+    void grow(std::size_t count) {
+        for (auto& coordinate : start_) coordinate.resize(count);
+    }
+
     std::array<std::vector<T>, 8> start_;
     std::vector<std::int32_t> n_;
     std::vector<T> r_, ra_, rb_, de_, trap_;
+    std::size_t count_ = 0;
 };
 
 }  // namespace dqj
