@@ -1,6 +1,7 @@
 // The nearest seed of every voxel of a region (nearest_seed.hpp).
 #include "nearest_seed.hpp"
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cstdint>
@@ -11,6 +12,7 @@
 #include <openvdb/tools/Prune.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
 
 #include "thread_scratch.hpp"
 
@@ -20,7 +22,11 @@ namespace {
 using IdLeaf = openvdb::Int32Tree::LeafNodeType;
 constexpr std::uint64_t kNone = std::numeric_limits<std::uint64_t>::max();
 constexpr std::int32_t kUnreached = -1;
-constexpr std::int32_t kClaimed = -2;  // reached in the layer being built, its seed not chosen yet
+// During a round a claimed voxel holds claim(its seed): kClaimed if it had none, else -3 - seed.
+constexpr std::int32_t kClaimed = -2;
+constexpr std::int32_t claim(std::int32_t seed) { return seed >= 0 ? -3 - seed : kClaimed; }
+/// The seed a slot's value stands for, claimed or not; negative: none yet.
+constexpr std::int32_t seedOf(std::int32_t value) { return value <= -3 ? -3 - value : value; }
 
 /// The 26 neighbours' steps.
 constexpr std::array<std::array<int, 3>, 26> kSteps = [] {
@@ -119,44 +125,60 @@ openvdb::Int32Tree::Ptr nearestSeeds(const openvdb::MaskTree& region, const std:
         }
     }
 
-    // Each further layer: the unreached neighbours of the last one (claimed once each, in any
-    // order), then each one's nearest seed among its neighbours reached before (so the result
-    // does not depend on the order), then those written.
+    // Each further round: the neighbours of the voxels that changed in the last one which are
+    // unreached or nearer to such a voxel's seed than to their own (claimed once each, in any
+    // order), then each one's nearest seed of its own and its neighbours' (read only, so the
+    // result does not depend on the order), then those that changed written. Reached voxels are
+    // taken up again because the rounds are layers of 26-neighbour steps, not of distance: a
+    // voxel first reached from one seed may be nearer to another that arrives a round later.
+    // Every change brings a voxel nearer to its seed, so the rounds end.
     ThreadScratch<std::vector<std::uint64_t>> claims;
     std::vector<std::int32_t> chosen;
+    auto squared = [&](const openvdb::Vec3f& at, std::int32_t seed) {
+        return (at - points[std::size_t(seed)]).lengthSqr();
+    };
     while (!layer.empty()) {
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, layer.size(), 1024),
-                          [&](const tbb::blocked_range<std::size_t>& range) {
-                              std::vector<std::uint64_t>& claimed = claims.local();
-                              for (std::size_t index = range.begin(); index != range.end(); ++index)
-                                  for (const auto& [dx, dy, dz] : kSteps) {
-                                      const std::uint64_t next = slots.step(layer[index], dx, dy, dz);
-                                      if (next == kNone) continue;
-                                      std::int32_t unreached = kUnreached;
-                                      auto id = slots.id(next);
-                                      if (id.load(std::memory_order_relaxed) == kUnreached &&
-                                          id.compare_exchange_strong(unreached, kClaimed, std::memory_order_relaxed))
-                                          claimed.push_back(next);
-                                  }
-                          });
+        tbb::parallel_for(
+            tbb::blocked_range<std::size_t>(0, layer.size(), 1024), [&](const tbb::blocked_range<std::size_t>& range) {
+                std::vector<std::uint64_t>& claimed = claims.local();
+                for (std::size_t index = range.begin(); index != range.end(); ++index) {
+                    const std::int32_t seed = seedOf(slots.id(layer[index]).load(std::memory_order_relaxed));
+                    const openvdb::Vec3f from = slots.coord(layer[index]).asVec3s();
+                    for (const auto& [dx, dy, dz] : kSteps) {
+                        const std::uint64_t next = slots.step(layer[index], dx, dy, dz);
+                        if (next == kNone) continue;
+                        auto id = slots.id(next);
+                        std::int32_t current = id.load(std::memory_order_relaxed);
+                        if (current == seed || current == kClaimed || current <= -3) continue;
+                        const openvdb::Vec3f at = from + openvdb::Vec3f(float(dx), float(dy), float(dz));
+                        const bool take = current == kUnreached || squared(at, seed) < squared(at, current);
+                        if (take && id.compare_exchange_strong(current, claim(current), std::memory_order_relaxed))
+                            claimed.push_back(next);
+                    }
+                }
+            });
         layer.clear();
         for (std::vector<std::uint64_t>& claimed : claims) {
             layer.insert(layer.end(), claimed.begin(), claimed.end());
             claimed.clear();
         }
+        // In slot order, so that neighbouring voxels are worked on together (in the claims'
+        // order, nearly every step was a cache miss).
+        tbb::parallel_sort(layer.begin(), layer.end());
         chosen.resize(layer.size());
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, layer.size(), 1024),
                           [&](const tbb::blocked_range<std::size_t>& range) {
                               for (std::size_t index = range.begin(); index != range.end(); ++index) {
-                                  const openvdb::Vec3f at = slots.coord(layer[index]).asVec3s();
-                                  std::int32_t best = kUnreached;
-                                  float nearest = std::numeric_limits<float>::infinity();
+                                  const std::uint64_t slot = layer[index];
+                                  const openvdb::Vec3f at = slots.coord(slot).asVec3s();
+                                  std::int32_t best = seedOf(slots.id(slot).load(std::memory_order_relaxed));
+                                  float nearest = best >= 0 ? squared(at, best) : std::numeric_limits<float>::infinity();
                                   for (const auto& [dx, dy, dz] : kSteps) {
-                                      const std::uint64_t from = slots.step(layer[index], dx, dy, dz);
+                                      const std::uint64_t from = slots.step(slot, dx, dy, dz);
                                       if (from == kNone) continue;
-                                      const std::int32_t seed = slots.id(from).load(std::memory_order_relaxed);
-                                      if (seed < 0) continue;
-                                      const float distance = (at - points[std::size_t(seed)]).lengthSqr();
+                                      const std::int32_t seed = seedOf(slots.id(from).load(std::memory_order_relaxed));
+                                      if (seed < 0 || seed == best) continue;
+                                      const float distance = squared(at, seed);
                                       if (distance < nearest || (distance == nearest && seed < best)) {
                                           nearest = distance;
                                           best = seed;
@@ -165,11 +187,16 @@ openvdb::Int32Tree::Ptr nearestSeeds(const openvdb::MaskTree& region, const std:
                                   chosen[index] = best;
                               }
                           });
+        // Written; what kept its seed leaves the round.
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, layer.size(), 4096),
                           [&](const tbb::blocked_range<std::size_t>& range) {
-                              for (std::size_t index = range.begin(); index != range.end(); ++index)
-                                  slots.id(layer[index]).store(chosen[index], std::memory_order_relaxed);
+                              for (std::size_t index = range.begin(); index != range.end(); ++index) {
+                                  auto id = slots.id(layer[index]);
+                                  if (seedOf(id.load(std::memory_order_relaxed)) == chosen[index]) layer[index] = kNone;
+                                  id.store(chosen[index], std::memory_order_relaxed);
+                              }
                           });
+        std::erase(layer, kNone);
     }
 
     // What no seed reached is not part of the result.
