@@ -112,62 +112,64 @@ struct SurfaceSeeds {
     }
 };
 
-/// The seeds of `surface`, in the order of its leaves (deterministic). One orbit per seed,
-/// kSurfaceColourOffset voxels outside its surface point along the gradient, where the renderer
-/// takes its colours; a leaf's seeds go through the SIMD kernel together.
+/// The seeds of one leaf of the level set. One orbit per seed, kSurfaceColourOffset voxels
+/// outside its surface point along the gradient, where the renderer takes its colours; the
+/// leaf's seeds go through the SIMD kernel together.
+void addLeafSeeds(const Params& params, const openvdb::tree::ValueAccessor<const openvdb::FloatTree>& surface,
+                  const openvdb::FloatTree::LeafNodeType& leaf, double voxelSize, BatchBuffer<double>& batch,
+                  SurfaceSeeds& seeds) {
+    const Slice slice = params.slice.effective();
+    batch.clear();
+    for (auto on = leaf.cbeginValueOn(); on; ++on) {
+        const openvdb::Coord ijk = on.getCoord();
+        const bool inside = *on < 0.0f;
+        double around[6];  // -x, +x, -y, +y, -z, +z
+        bool crossing = false;
+        for (int axis = 0; axis < 3; ++axis)
+            for (int side = 0; side < 2; ++side) {
+                openvdb::Coord next = ijk;
+                next[axis] += side ? 1 : -1;
+                const float value = surface.getValue(next);
+                crossing = crossing || (value < 0.0f) != inside;
+                around[2 * axis + side] = double(value);
+            }
+        if (!crossing) continue;
+        glm::dvec3 normal(around[1] - around[0], around[3] - around[2], around[5] - around[4]);
+        const double length = glm::length(normal);
+        if (length > 0.0) normal /= length;
+        // The bake's grid maps index to world by the voxel size alone.
+        const glm::dvec3 point = glm::dvec3(ijk.x(), ijk.y(), ijk.z()) - double(*on) / voxelSize * normal;
+        seeds.voxels.push_back(ijk);
+        seeds.points.emplace_back(float(point.x), float(point.y), float(point.z));
+        batch.add(slice.map((point + kSurfaceColourOffset * normal) * voxelSize));
+    }
+    if (seeds.voxels.empty()) return;
+    batch.evaluate(params.fractal);
+    for (std::size_t seed = 0; seed < seeds.voxels.size(); ++seed) {
+        const Escape escape = batch.escape(seed);
+        if (hasGrid(params.bake, BakeGrid::Color)) {
+            const glm::dvec3 c = orbitColour(params.material, params.fractal, escape);
+            seeds.colours.emplace_back(float(c.x), float(c.y), float(c.z));
+        }
+        if (hasGrid(params.bake, BakeGrid::Trap)) seeds.traps.push_back(float(escape.trap));
+        if (hasGrid(params.bake, BakeGrid::Iterations))
+            seeds.iterations.push_back(float(smoothIterations(params.fractal, escape)));
+    }
+}
+
+/// The seeds of `surface`, in the order of its leaves (deterministic).
 SurfaceSeeds surfaceSeeds(const Params& params, const openvdb::FloatGrid& surface) {
-    const bool color = hasGrid(params.bake, BakeGrid::Color);
-    const bool trap = hasGrid(params.bake, BakeGrid::Trap);
-    const bool iterations = hasGrid(params.bake, BakeGrid::Iterations);
     std::vector<const openvdb::FloatTree::LeafNodeType*> leaves;
     surface.tree().getNodes(leaves);
     std::vector<SurfaceSeeds> perLeaf(leaves.size());
-    const Slice slice = params.slice.effective();
-    // The bake's grid maps index to world by the voxel size alone.
-    const double h = surface.voxelSize()[0];
     ThreadScratch<BatchBuffer<double>> batches;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()), [&](const tbb::blocked_range<std::size_t>&
-                                                                                 range) {
-        openvdb::tree::ValueAccessor<const openvdb::FloatTree> accessor(surface.tree());
-        BatchBuffer<double>& batch = batches.local();
-        for (std::size_t index = range.begin(); index != range.end(); ++index) {
-            SurfaceSeeds& seeds = perLeaf[index];
-            batch.clear();
-            for (auto on = leaves[index]->cbeginValueOn(); on; ++on) {
-                const openvdb::Coord ijk = on.getCoord();
-                const bool inside = *on < 0.0f;
-                double around[6];
-                bool crossing = false;
-                for (int axis = 0; axis < 3; ++axis)
-                    for (int side = 0; side < 2; ++side) {
-                        openvdb::Coord next = ijk;
-                        next[axis] += side ? 1 : -1;
-                        const float value = accessor.getValue(next);
-                        crossing = crossing || (value < 0.0f) != inside;
-                        around[2 * axis + side] = double(value);
-                    }
-                if (!crossing) continue;
-                glm::dvec3 normal(around[1] - around[0], around[3] - around[2], around[5] - around[4]);
-                const double length = glm::length(normal);
-                if (length > 0.0) normal /= length;
-                const glm::dvec3 point = glm::dvec3(ijk.x(), ijk.y(), ijk.z()) - double(*on) / h * normal;
-                seeds.voxels.push_back(ijk);
-                seeds.points.emplace_back(float(point.x), float(point.y), float(point.z));
-                batch.add(slice.map((point + kSurfaceColourOffset * normal) * h));
-            }
-            if (seeds.voxels.empty()) continue;
-            batch.evaluate(params.fractal);
-            for (std::size_t seed = 0; seed < seeds.voxels.size(); ++seed) {
-                const Escape escape = batch.escape(seed);
-                if (color) {
-                    const glm::dvec3 c = orbitColour(params.material, params.fractal, escape);
-                    seeds.colours.emplace_back(float(c.x), float(c.y), float(c.z));
-                }
-                if (trap) seeds.traps.push_back(float(escape.trap));
-                if (iterations) seeds.iterations.push_back(float(smoothIterations(params.fractal, escape)));
-            }
-        }
-    });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                          const openvdb::tree::ValueAccessor<const openvdb::FloatTree> accessor(surface.tree());
+                          for (std::size_t index = range.begin(); index != range.end(); ++index)
+                              addLeafSeeds(params, accessor, *leaves[index], surface.voxelSize()[0], batches.local(),
+                                           perLeaf[index]);
+                      });
     SurfaceSeeds seeds;
     for (const SurfaceSeeds& leaf : perLeaf) seeds.append(leaf);
     return seeds;
@@ -179,7 +181,7 @@ typename GridT::Ptr seedValueGrid(const openvdb::Int32Tree& ids, const std::vect
     using TreeT = typename GridT::TreeType;
     auto tree = std::make_shared<TreeT>(ids, typename TreeT::ValueType(0), openvdb::TopologyCopy());
     openvdb::tree::LeafManager<TreeT> leaves(*tree);
-    leaves.foreach([&](typename TreeT::LeafNodeType& leaf, std::size_t) {
+    leaves.foreach ([&](typename TreeT::LeafNodeType& leaf, std::size_t) {
         const openvdb::Int32Tree::LeafNodeType* seeds = ids.probeConstLeaf(leaf.origin());
         for (auto on = leaf.beginValueOn(); on; ++on) on.setValue(values[std::size_t(seeds->getValue(on.pos()))]);
     });

@@ -172,7 +172,8 @@ openvdb::Int32Tree::Ptr nearestSeeds(const openvdb::MaskTree& region, const std:
                                   const std::uint64_t slot = layer[index];
                                   const openvdb::Vec3f at = slots.coord(slot).asVec3s();
                                   std::int32_t best = seedOf(slots.id(slot).load(std::memory_order_relaxed));
-                                  float nearest = best >= 0 ? squared(at, best) : std::numeric_limits<float>::infinity();
+                                  float nearest =
+                                      best >= 0 ? squared(at, best) : std::numeric_limits<float>::infinity();
                                   for (const auto& [dx, dy, dz] : kSteps) {
                                       const std::uint64_t from = slots.step(slot, dx, dy, dz);
                                       if (from == kNone) continue;

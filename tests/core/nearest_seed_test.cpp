@@ -29,7 +29,8 @@ Seeds randomSeeds(int count, int size, unsigned seed) {
     for (int index = 0; index < count; ++index) {
         const Vec3f point(at(random), at(random), at(random));
         seeds.points.push_back(point);
-        seeds.voxels.emplace_back(int(std::lround(point.x())), int(std::lround(point.y())), int(std::lround(point.z())));
+        seeds.voxels.emplace_back(int(std::lround(point.x())), int(std::lround(point.y())),
+                                  int(std::lround(point.z())));
     }
     return seeds;
 }
@@ -62,7 +63,8 @@ TEST(NearestSeeds, EachVoxelTakesTheNearestSeedOrOneAboutAsNear) {
         worst = std::max(worst, taken - nearest);
         ++voxels;
     }
-    std::printf("nearest seed: %.2f %% of %zu voxels exact, worst %.3f voxels farther\n", 100.0 * double(exact) / double(voxels), voxels, double(worst));
+    std::printf("nearest seed: %.2f %% of %zu voxels exact, worst %.3f voxels farther\n",
+                100.0 * double(exact) / double(voxels), voxels, double(worst));
     // Measured: all exact (first arrivals alone, without the later rounds: 90 %, up to 6 voxels off).
     EXPECT_GT(double(exact), 0.995 * double(voxels));
     EXPECT_LT(worst, 0.5f);
