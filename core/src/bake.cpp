@@ -56,12 +56,15 @@ private:
 /// Memory per sampled 8^3 leaf beyond the sampled leaf itself: the rebuild's mesh and distance
 /// grids, the level set, the fog volume; attribute grids on top. Measured on the default
 /// fractal (peak RSS minus the 65 MB of a tiny bake, over sampled leaves: 4.3 kB at 256^3,
-/// 5.2 kB at 512^3, 4.9 kB at 1024^3) and doubled for headroom.
+/// 5.2 kB at 512^3, 4.9 kB at 1024^3) and doubled for headroom. With the colour grid (its
+/// seeds, their propagation and the grid) 7.7 kB at 512^3 and 9.8 kB at 1024^3 in all, so
+/// about 5 kB more, doubled (the sweeps it replaced took 17 kB: 4.2 GB at 1024^3, above the
+/// 12 kB this allowed).
 MemoryModel bakeMemoryModel(const BakeSettings& bake) {
     MemoryModel model;
     model.fixedBytes = 96.0 * 1024 * 1024;
     model.bytesPerLeaf = 9.0 * 1024;
-    if (hasGrid(bake, BakeGrid::Color)) model.bytesPerLeaf += 12.0 * 1024;
+    if (hasGrid(bake, BakeGrid::Color)) model.bytesPerLeaf += 10.0 * 1024;
     if (hasGrid(bake, BakeGrid::Trap)) model.bytesPerLeaf += 4.0 * 1024;
     if (hasGrid(bake, BakeGrid::Iterations)) model.bytesPerLeaf += 4.0 * 1024;
     return model;
@@ -412,11 +415,15 @@ BakeStats bakeVdb(const Params& params, const std::string& path, const BakeOptio
         kept = keptBox(full, ownedBox(full, *options.tile));
     }
 
+    // The attribute grids before the density, so that the density is not held while their
+    // seeds and propagation are (the peak at 1024^3); the file keeps its order.
+    openvdb::GridPtrVec attributes;
+    addAttributeGrids(params, *surface, kept ? &*kept : nullptr, staged.stage(BakeStage::Grids, 0.85, 0.95), stats,
+                      attributes);
     openvdb::GridPtrVec grids;
     if (hasGrid(params.bake, BakeGrid::Surface) || kept) grids.push_back(surface);
     if (hasGrid(params.bake, BakeGrid::Density) && !kept) grids.push_back(densityFromSurface(*surface));
-    addAttributeGrids(params, *surface, kept ? &*kept : nullptr, staged.stage(BakeStage::Grids, 0.85, 0.95), stats,
-                      grids);
+    grids.insert(grids.end(), attributes.begin(), attributes.end());
     if (kept) {
         surface->tree().clip(*kept);
         stats.activeVoxels = surface->activeVoxelCount();
