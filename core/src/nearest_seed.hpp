@@ -2,12 +2,13 @@
 // (internal to libdqjulia). The bake's attribute grids use it to give each voxel below the
 // surface the colour of the surface point nearest to it (bake.cpp, addAttributeGrids).
 //
-// The seeds spread outwards from their voxels one layer (26 neighbours) at a time; each newly
-// reached voxel takes, of the seeds its reached neighbours hold, the one nearest to it. This is
-// a vector distance transform: exact where the nearest seed's region is convex along the way,
-// off by a seed at most where two seeds are about equally near (at the region's medial
-// surfaces). Cost: about 26 neighbour reads twice per voxel, parallel over each layer; memory:
-// an Int32Tree of the region's topology.
+// The seeds spread outwards from their voxels in rounds of 26-neighbour steps; a voxel reached
+// takes, of its own and its neighbours' seeds, the one nearest to it, and a voxel reached
+// before is taken up again when a neighbour's seed is nearer, until nothing changes. A vector
+// distance transform: not always the nearest seed, but one about as near (below a sphere of
+// seeds 88.5 % exact, the rest within 0.09 voxel; nearest_seed_test.cpp). Cost: 26 neighbour
+// reads twice per voxel and round it changes in, parallel over each round; memory: an
+// Int32Tree of the region's topology.
 #pragma once
 
 #include <vector>
