@@ -23,15 +23,18 @@
 #include <unistd.h>
 #endif
 
-#include <openvdb/tools/FastSweeping.h>
-#include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/LevelSetRebuild.h>
 #include <openvdb/tools/LevelSetUtil.h>
 #include <openvdb/tools/Morphology.h>
+#include <openvdb/tree/LeafManager.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "atomic_file.hpp"
 #include "level_set.hpp"
+#include "nearest_seed.hpp"
 #include "parallel_progress.hpp"
+#include "thread_scratch.hpp"
 #include "tile_geometry.hpp"
 #include "vdb_file.hpp"
 
@@ -53,12 +56,15 @@ private:
 /// Memory per sampled 8^3 leaf beyond the sampled leaf itself: the rebuild's mesh and distance
 /// grids, the level set, the fog volume; attribute grids on top. Measured on the default
 /// fractal (peak RSS minus the 65 MB of a tiny bake, over sampled leaves: 4.3 kB at 256^3,
-/// 5.2 kB at 512^3, 4.9 kB at 1024^3) and doubled for headroom.
+/// 5.2 kB at 512^3, 4.9 kB at 1024^3) and doubled for headroom. With the colour grid (its
+/// seeds, their propagation and the grid) 7.7 kB at 512^3 and 9.8 kB at 1024^3 in all, so
+/// about 5 kB more, doubled (the sweeps it replaced took 17 kB: 4.2 GB at 1024^3, above the
+/// 12 kB this allowed).
 MemoryModel bakeMemoryModel(const BakeSettings& bake) {
     MemoryModel model;
     model.fixedBytes = 96.0 * 1024 * 1024;
     model.bytesPerLeaf = 9.0 * 1024;
-    if (hasGrid(bake, BakeGrid::Color)) model.bytesPerLeaf += 12.0 * 1024;
+    if (hasGrid(bake, BakeGrid::Color)) model.bytesPerLeaf += 10.0 * 1024;
     if (hasGrid(bake, BakeGrid::Trap)) model.bytesPerLeaf += 4.0 * 1024;
     if (hasGrid(bake, BakeGrid::Iterations)) model.bytesPerLeaf += 4.0 * 1024;
     return model;
@@ -91,30 +97,108 @@ openvdb::MaskTree attributeVoxels(const openvdb::FloatGrid& surface, const BakeS
     return mask;
 }
 
-using SurfaceAccessor = openvdb::tree::ValueAccessor<const openvdb::FloatTree>;
+/// The seeds of the attribute grids: the level set's voxels next to a zero crossing (a face
+/// neighbour of the other sign), each with the surface point nearest to it (index space: the
+/// voxel moved by its distance against the gradient) and the attributes there.
+struct SurfaceSeeds {
+    std::vector<openvdb::Coord> voxels;
+    std::vector<openvdb::Vec3f> points;
+    std::vector<openvdb::Vec3s> colours;
+    std::vector<float> traps, iterations;
 
-/// A sweep's boundary functor with its own accessor to the level set: the sweep copies its
-/// functor once per thread, so each thread reads the level set through its own cache (the tree
-/// itself, read without one, starts every read at the root).
-template <typename F>
-struct WithAccessor {
-    F f;
-    mutable SurfaceAccessor accessor;
-    auto operator()(const openvdb::Vec3R& xyz) const { return f(accessor, xyz); }
+    void append(const SurfaceSeeds& other) {
+        voxels.insert(voxels.end(), other.voxels.begin(), other.voxels.end());
+        points.insert(points.end(), other.points.begin(), other.points.end());
+        colours.insert(colours.end(), other.colours.begin(), other.colours.end());
+        traps.insert(traps.end(), other.traps.begin(), other.traps.end());
+        iterations.insert(iterations.end(), other.iterations.begin(), other.iterations.end());
+    }
 };
 
-template <typename F>
-WithAccessor<F> withAccessor(const openvdb::FloatTree& tree, F f) {
-    return WithAccessor<F>{std::move(f), SurfaceAccessor(tree)};
+/// The seeds of one leaf of the level set. One orbit per seed, kSurfaceColourOffset voxels
+/// outside its surface point along the gradient, where the renderer takes its colours; the
+/// leaf's seeds go through the SIMD kernel together.
+void addLeafSeeds(const Params& params, const openvdb::tree::ValueAccessor<const openvdb::FloatTree>& surface,
+                  const openvdb::FloatTree::LeafNodeType& leaf, double voxelSize, BatchBuffer<double>& batch,
+                  SurfaceSeeds& seeds) {
+    const Slice slice = params.slice.effective();
+    batch.clear();
+    for (auto on = leaf.cbeginValueOn(); on; ++on) {
+        const openvdb::Coord ijk = on.getCoord();
+        const bool inside = *on < 0.0f;
+        double around[6];  // -x, +x, -y, +y, -z, +z
+        bool crossing = false;
+        for (int axis = 0; axis < 3; ++axis)
+            for (int side = 0; side < 2; ++side) {
+                openvdb::Coord next = ijk;
+                next[axis] += side ? 1 : -1;
+                const float value = surface.getValue(next);
+                crossing = crossing || (value < 0.0f) != inside;
+                around[2 * axis + side] = double(value);
+            }
+        if (!crossing) continue;
+        glm::dvec3 normal(around[1] - around[0], around[3] - around[2], around[5] - around[4]);
+        const double length = glm::length(normal);
+        if (length > 0.0) normal /= length;
+        // The bake's grid maps index to world by the voxel size alone.
+        const glm::dvec3 point = glm::dvec3(ijk.x(), ijk.y(), ijk.z()) - double(*on) / voxelSize * normal;
+        seeds.voxels.push_back(ijk);
+        seeds.points.emplace_back(float(point.x), float(point.y), float(point.z));
+        batch.add(slice.map((point + kSurfaceColourOffset * normal) * voxelSize));
+    }
+    if (seeds.voxels.empty()) return;
+    batch.evaluate(params.fractal);
+    for (std::size_t seed = 0; seed < seeds.voxels.size(); ++seed) {
+        const Escape escape = batch.escape(seed);
+        if (hasGrid(params.bake, BakeGrid::Color)) {
+            const glm::dvec3 c = orbitColour(params.material, params.fractal, escape);
+            seeds.colours.emplace_back(float(c.x), float(c.y), float(c.z));
+        }
+        if (hasGrid(params.bake, BakeGrid::Trap)) seeds.traps.push_back(float(escape.trap));
+        if (hasGrid(params.bake, BakeGrid::Iterations))
+            seeds.iterations.push_back(float(smoothIterations(params.fractal, escape)));
+    }
+}
+
+/// The seeds of `surface`, in the order of its leaves (deterministic).
+SurfaceSeeds surfaceSeeds(const Params& params, const openvdb::FloatGrid& surface) {
+    std::vector<const openvdb::FloatTree::LeafNodeType*> leaves;
+    surface.tree().getNodes(leaves);
+    std::vector<SurfaceSeeds> perLeaf(leaves.size());
+    ThreadScratch<BatchBuffer<double>> batches;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                          const openvdb::tree::ValueAccessor<const openvdb::FloatTree> accessor(surface.tree());
+                          for (std::size_t index = range.begin(); index != range.end(); ++index)
+                              addLeafSeeds(params, accessor, *leaves[index], surface.voxelSize()[0], batches.local(),
+                                           perLeaf[index]);
+                      });
+    SurfaceSeeds seeds;
+    for (const SurfaceSeeds& leaf : perLeaf) seeds.append(leaf);
+    return seeds;
+}
+
+/// A grid of `ids`' topology holding, at each voxel, the value of its seed.
+template <typename GridT>
+typename GridT::Ptr seedValueGrid(const openvdb::Int32Tree& ids, const std::vector<typename GridT::ValueType>& values) {
+    using TreeT = typename GridT::TreeType;
+    auto tree = std::make_shared<TreeT>(ids, typename TreeT::ValueType(0), openvdb::TopologyCopy());
+    openvdb::tree::LeafManager<TreeT> leaves(*tree);
+    leaves.foreach ([&](typename TreeT::LeafNodeType& leaf, std::size_t) {
+        const openvdb::Int32Tree::LeafNodeType* seeds = ids.probeConstLeaf(leaf.origin());
+        for (auto on = leaf.beginValueOn(); on; ++on) on.setValue(values[std::size_t(seeds->getValue(on.pos()))]);
+    });
+    return GridT::create(tree);
 }
 
 /// The attribute grids ("color", "trap", "iterations") on attributeVoxels(), within `kept` if
 /// given (a tile's), each an extension field: every voxel holds the value at the surface point
-/// nearest to it (OpenVDB's fast sweeping, along the distance's gradient), so the inside shows,
-/// through the depth light reaches, the colour its surface has, as the mesh's vertices and the
-/// preview do; a voxel's own orbit would give the inside's colour instead (bounded orbits: the
-/// palette's far end). One fractal evaluation a surface crossing (about the band's voxels that
-/// touch the surface), then a sweep over the voxels; colour and smooth count from coloring.hpp.
+/// nearest to it, so the inside shows, through the depth light reaches, the colour its surface
+/// has, as the mesh's vertices and the preview do; a voxel's own orbit would give the inside's
+/// colour instead (bounded orbits: the palette's far end). One fractal evaluation per surface
+/// seed (surfaceSeeds), then each voxel takes its nearest seed (nearestSeeds), one propagation
+/// for all the grids; colour and smooth count from coloring.hpp. A tile works on all it baked,
+/// its halo included, and keeps its box.
 void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, const openvdb::CoordBBox* kept,
                        const ProgressCallback& progress, BakeStats& stats, openvdb::GridPtrVec& grids) {
     const bool color = hasGrid(params.bake, BakeGrid::Color);
@@ -122,32 +206,13 @@ void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, 
     const bool iterations = hasGrid(params.bake, BakeGrid::Iterations);
     if (!color && !trap && !iterations) return;
     if (progress && !progress(0.0)) throw Cancelled();
-    // The sweep's domain: the level set grown to the attribute voxels (its band stops short of
-    // their depth). The sweep starts from the voxels next to the zero crossing and reads only the
-    // sign of the others, which the level set's inactive values already give (+-background), so
-    // the grown voxels need no distances of their own (a maskSdf pass first would be a second
-    // sweep over the same voxels). A tile sweeps over all it baked, its halo included, and keeps
-    // its box.
-    const openvdb::FloatGrid::Ptr distance = surface.deepCopy();
-    distance->tree().topologyUnion(attributeVoxels(surface, params.bake));
-    const Slice slice = params.slice.effective();
-    std::atomic<std::uint64_t> evaluated{0};
-    // OpenVDB 10's sweep passes the functors index coordinates (it takes the transform of the
-    // extension grid it creates, which has none); the bake's grid is index * voxel size. The
-    // orbit is taken kSurfaceColourOffset voxels outside, along the distance's gradient.
-    const double h = surface.voxelSize()[0];
-    auto atSurface = [&](SurfaceAccessor& accessor, const openvdb::Vec3R& ijk) {
-        ++evaluated;
-        auto at = [&](double x, double y, double z) {
-            return double(openvdb::tools::BoxSampler::sample(accessor, ijk + openvdb::Vec3R(x, y, z)));
-        };
-        glm::dvec3 gradient(at(0.5, 0, 0) - at(-0.5, 0, 0), at(0, 0.5, 0) - at(0, -0.5, 0),
-                            at(0, 0, 0.5) - at(0, 0, -0.5));
-        const double length = glm::length(gradient);
-        if (length > 0.0) gradient /= length;
-        const glm::dvec3 p = glm::dvec3(ijk.x(), ijk.y(), ijk.z()) + kSurfaceColourOffset * gradient;
-        return evaluate(params.fractal, slice.map(p * h));
-    };
+    SurfaceSeeds seeds = surfaceSeeds(params, surface);
+    stats.evaluated += seeds.voxels.size();
+    if (progress && !progress(0.3)) throw Cancelled();
+    openvdb::Int32Tree::Ptr ids = nearestSeeds(attributeVoxels(surface, params.bake), seeds.voxels, seeds.points);
+    seeds.voxels = {};
+    seeds.points = {};
+    if (progress && !progress(0.8)) throw Cancelled();
     auto name = [&](auto grid, const char* label) {
         if (kept) grid->tree().clip(*kept);
         grid->setTransform(surface.transform().copy());
@@ -156,28 +221,10 @@ void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, 
         grids.push_back(grid);
         return grid;
     };
-    if (color) {
-        auto rgb = withAccessor(surface.tree(), [&](SurfaceAccessor& accessor, const openvdb::Vec3R& xyz) {
-            const glm::dvec3 c = orbitColour(params.material, params.fractal, atSurface(accessor, xyz));
-            return openvdb::Vec3s(float(c.x), float(c.y), float(c.z));
-        });
-        name(openvdb::tools::sdfToExt(*distance, rgb, openvdb::Vec3s(0.0f)), "color")
-            ->setVectorType(openvdb::VEC_INVARIANT);
-        if (progress && !progress(0.5)) throw Cancelled();
-    }
-    if (trap) {
-        auto value = withAccessor(surface.tree(), [&](SurfaceAccessor& accessor, const openvdb::Vec3R& xyz) {
-            return float(atSurface(accessor, xyz).trap);
-        });
-        name(openvdb::tools::sdfToExt(*distance, value, 0.0f), "trap");
-    }
-    if (iterations) {
-        auto value = withAccessor(surface.tree(), [&](SurfaceAccessor& accessor, const openvdb::Vec3R& xyz) {
-            return float(smoothIterations(params.fractal, atSurface(accessor, xyz)));
-        });
-        name(openvdb::tools::sdfToExt(*distance, value, 0.0f), "iterations");
-    }
-    stats.evaluated += evaluated.load();
+    if (color)
+        name(seedValueGrid<openvdb::Vec3SGrid>(*ids, seeds.colours), "color")->setVectorType(openvdb::VEC_INVARIANT);
+    if (trap) name(seedValueGrid<openvdb::FloatGrid>(*ids, seeds.traps), "trap");
+    if (iterations) name(seedValueGrid<openvdb::FloatGrid>(*ids, seeds.iterations), "iterations");
     if (progress && !progress(1.0)) throw Cancelled();
 }
 
@@ -368,11 +415,15 @@ BakeStats bakeVdb(const Params& params, const std::string& path, const BakeOptio
         kept = keptBox(full, ownedBox(full, *options.tile));
     }
 
+    // The attribute grids before the density, so that the density is not held while their
+    // seeds and propagation are (the peak at 1024^3); the file keeps its order.
+    openvdb::GridPtrVec attributes;
+    addAttributeGrids(params, *surface, kept ? &*kept : nullptr, staged.stage(BakeStage::Grids, 0.85, 0.95), stats,
+                      attributes);
     openvdb::GridPtrVec grids;
     if (hasGrid(params.bake, BakeGrid::Surface) || kept) grids.push_back(surface);
     if (hasGrid(params.bake, BakeGrid::Density) && !kept) grids.push_back(densityFromSurface(*surface));
-    addAttributeGrids(params, *surface, kept ? &*kept : nullptr, staged.stage(BakeStage::Grids, 0.85, 0.95), stats,
-                      grids);
+    grids.insert(grids.end(), attributes.begin(), attributes.end());
     if (kept) {
         surface->tree().clip(*kept);
         stats.activeVoxels = surface->activeVoxelCount();
