@@ -247,7 +247,8 @@ TEST_F(Hostile, SaveParamsOntoTheImageIsRejected) {
 TEST_F(Hostile, AFileThatAppearsDuringTheWorkIsNotReplacedWithoutForce) {
     const fs::path output = dir_ / "race.png";
     const pid_t pid =
-        dqj::test::spawnProgram(DQJ_CLI, {"render", "-q", "-W", "800", "-H", "600", "-s", "2", "-o", output.string()},
+        // About 2 s of work on 2 cores (0.2 s at 800x600): still running when the other file appears.
+        dqj::test::spawnProgram(DQJ_CLI, {"render", "-q", "-W", "1600", "-H", "1200", "-s", "3", "-o", output.string()},
                                 dir_ / "stderr.txt");
     ASSERT_GT(pid, 0);
     std::this_thread::sleep_for(std::chrono::milliseconds(300));
