@@ -876,7 +876,7 @@ struct TileBuffers {
     std::vector<ShadowMarch> shadowSlots;  // the jobs' shadow marches (RayJob's `shadows`)
     std::vector<double> columnX;           // image plane x of the tile's sub-pixel columns
     std::vector<double> rowY;              // and y of its rows
-    std::vector<glm::dvec3> rowBackground;  // and the background of each row
+    std::vector<glm::dvec3> rowBackground;    // and the background of each row
     std::vector<glm::dvec3> pixelBackground;  // per pixel row: a pixel's colour if no sample hits
     std::vector<double> starts;            // per cone block: where its rays start (+inf: all miss)
     std::vector<std::size_t> firstJob;     // per pixel of the pass: its first job, or kNoJob
