@@ -44,25 +44,36 @@ openvdb::MaskTree box(const Coord& low, const Coord& high) {
 
 float distance(const Coord& ijk, const Vec3f& point) { return (Vec3f(ijk.asVec3s()) - point).length(); }
 
+/// How near the seeds nearestSeeds() gave are, against the brute-force nearest seed of each voxel.
+struct Nearness {
+    std::size_t exact = 0, voxels = 0;
+    float worst = 0.0f;  ///< the largest excess distance, in voxels
+};
+
+Nearness nearness(const openvdb::Int32Tree& ids, const Seeds& seeds) {
+    Nearness result;
+    for (auto on = ids.cbeginValueOn(); on; ++on) {
+        const Coord ijk = on.getCoord();
+        float nearest = 1e30f;
+        for (const Vec3f& point : seeds.points) nearest = std::min(nearest, distance(ijk, point));
+        const int id = *on;
+        EXPECT_GE(id, 0);
+        if (id < 0) continue;
+        const float taken = distance(ijk, seeds.points[std::size_t(id)]);
+        result.exact += taken == nearest;
+        result.worst = std::max(result.worst, taken - nearest);
+        ++result.voxels;
+    }
+    return result;
+}
+
 TEST(NearestSeeds, EachVoxelTakesTheNearestSeedOrOneAboutAsNear) {
     const int size = 40;
     const openvdb::MaskTree region = box(Coord(0), Coord(size - 1));
     const Seeds seeds = randomSeeds(60, size, 7);
     const openvdb::Int32Tree::Ptr ids = dqj::nearestSeeds(region, seeds.voxels, seeds.points);
     EXPECT_EQ(ids->activeVoxelCount(), region.activeVoxelCount()) << "every voxel of a connected region is reached";
-    std::size_t exact = 0, voxels = 0;
-    float worst = 0.0f;
-    for (auto on = ids->cbeginValueOn(); on; ++on) {
-        const Coord ijk = on.getCoord();
-        float nearest = 1e30f;
-        for (const Vec3f& point : seeds.points) nearest = std::min(nearest, distance(ijk, point));
-        const int id = *on;
-        ASSERT_GE(id, 0);
-        const float taken = distance(ijk, seeds.points[std::size_t(id)]);
-        exact += taken == nearest;
-        worst = std::max(worst, taken - nearest);
-        ++voxels;
-    }
+    const auto [exact, voxels, worst] = nearness(*ids, seeds);
     std::printf("nearest seed: %.2f %% of %zu voxels exact, worst %.3f voxels farther\n",
                 100.0 * double(exact) / double(voxels), voxels, double(worst));
     // Measured: all exact (first arrivals alone, without the later rounds: 90 %, up to 6 voxels off).
@@ -90,16 +101,7 @@ TEST(NearestSeeds, BelowACurvedSurfaceEachVoxelTakesItsNearestPoint) {
             }
     const openvdb::Int32Tree::Ptr ids = dqj::nearestSeeds(region, seeds.voxels, seeds.points);
     EXPECT_EQ(ids->activeVoxelCount(), region.activeVoxelCount());
-    std::size_t exact = 0, voxels = 0;
-    float worst = 0.0f;
-    for (auto on = ids->cbeginValueOn(); on; ++on) {
-        float nearest = 1e30f;
-        for (const Vec3f& point : seeds.points) nearest = std::min(nearest, distance(on.getCoord(), point));
-        const float taken = distance(on.getCoord(), seeds.points[std::size_t(*on)]);
-        exact += taken == nearest;
-        worst = std::max(worst, taken - nearest);
-        ++voxels;
-    }
+    const auto [exact, voxels, worst] = nearness(*ids, seeds);
     std::printf("below a sphere: %.2f %% of %zu voxels exact, worst %.4f voxels farther\n",
                 100.0 * double(exact) / double(voxels), voxels, double(worst));
     // Measured: 88.5 % exact, the others at most 0.088 voxels farther than the nearest point
