@@ -118,10 +118,10 @@ struct SurfaceSeeds {
 /// The seeds of one leaf of the level set. One orbit per seed, kSurfaceColourOffset voxels
 /// outside its surface point along the gradient, where the renderer takes its colours; the
 /// leaf's seeds go through the SIMD kernel together.
-void addLeafSeeds(const Params& params, const openvdb::tree::ValueAccessor<const openvdb::FloatTree>& surface,
+void addLeafSeeds(const Params& params, const Slice& slice,
+                  const openvdb::tree::ValueAccessor<const openvdb::FloatTree>& surface,
                   const openvdb::FloatTree::LeafNodeType& leaf, double voxelSize, BatchBuffer<double>& batch,
                   SurfaceSeeds& seeds) {
-    const Slice slice = params.slice.effective();
     batch.clear();
     for (auto on = leaf.cbeginValueOn(); on; ++on) {
         const openvdb::Coord ijk = on.getCoord();
@@ -165,13 +165,14 @@ SurfaceSeeds surfaceSeeds(const Params& params, const openvdb::FloatGrid& surfac
     std::vector<const openvdb::FloatTree::LeafNodeType*> leaves;
     surface.tree().getNodes(leaves);
     std::vector<SurfaceSeeds> perLeaf(leaves.size());
+    const Slice slice = params.slice.effective();  // once, not per leaf
     ThreadScratch<BatchBuffer<double>> batches;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()),
                       [&](const tbb::blocked_range<std::size_t>& range) {
                           const openvdb::tree::ValueAccessor<const openvdb::FloatTree> accessor(surface.tree());
                           for (std::size_t index = range.begin(); index != range.end(); ++index)
-                              addLeafSeeds(params, accessor, *leaves[index], surface.voxelSize()[0], batches.local(),
-                                           perLeaf[index]);
+                              addLeafSeeds(params, slice, accessor, *leaves[index], surface.voxelSize()[0],
+                                           batches.local(), perLeaf[index]);
                       });
     SurfaceSeeds seeds;
     for (const SurfaceSeeds& leaf : perLeaf) seeds.append(leaf);
