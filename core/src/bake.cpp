@@ -23,7 +23,6 @@
 #include <unistd.h>
 #endif
 
-#include <openvdb/tools/LevelSetRebuild.h>
 #include <openvdb/tools/LevelSetUtil.h>
 #include <openvdb/tools/Morphology.h>
 #include <openvdb/tree/LeafManager.h>
@@ -32,6 +31,7 @@
 
 #include "atomic_file.hpp"
 #include "level_set.hpp"
+#include "mesh_distance.hpp"
 #include "nearest_seed.hpp"
 #include "parallel_progress.hpp"
 #include "thread_scratch.hpp"
@@ -42,16 +42,6 @@ namespace dqj {
 
 
 namespace {
-
-/// Lets OpenVDB's tools poll the `stop` flag of parallelForWithProgress.
-class StopInterrupter : public openvdb::util::NullInterrupter {
-public:
-    explicit StopInterrupter(const std::atomic<bool>& stop) : stop_(stop) {}
-    bool wasInterrupted(int = -1) override { return stop_.load(std::memory_order_relaxed); }
-
-private:
-    const std::atomic<bool>& stop_;
-};
 
 /// Memory per sampled 8^3 leaf beyond the sampled leaf itself: the rebuild's mesh and distance
 /// grids, the level set, the fog volume; attribute grids on top. Measured on the default
@@ -254,9 +244,7 @@ openvdb::FloatGrid::Ptr bakeLevelSet(const Params& params, const BakeOptions& op
     openvdb::FloatGrid::Ptr surface;
     parallelForWithProgress(1, progress.stage(BakeStage::LevelSet, sampledAt, rebuiltAt),
                             [&](std::size_t, const std::atomic<bool>& stop) {
-                                StopInterrupter interrupter(stop);
-                                surface = openvdb::tools::levelSetRebuild(*sampled.grid, 0.0f, band, band, nullptr,
-                                                                          &interrupter);
+                                surface = levelSetOfMesh(*sampled.grid, band, stop);
                             });
     sampled.grid.reset();
     surface->setName("surface");

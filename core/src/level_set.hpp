@@ -1,10 +1,10 @@
 // level_set.hpp - the first half of every bake: sample the surface function sparsely and turn
 // it into an exact narrow-band signed distance (internal to libdqjulia).
 //
-// f (sparse_sampler.hpp) is zero on the surface but is not a distance; OpenVDB's
-// levelSetRebuild meshes f = 0 and rasterises that mesh into a signed distance with the bake's
-// band width (exact distance to the mesh, negative inside). Cost: the sampling, then about one
-// mesh vertex and a band's worth of voxels per surface voxel; interruptible.
+// f (sparse_sampler.hpp) is zero on the surface but is not a distance; the level set is the
+// signed distance to f's mesh with the bake's band width (mesh_distance.hpp: exact within a
+// voxel of the mesh, negative inside). Cost: the sampling, then about one mesh vertex and a
+// band's worth of voxels per surface voxel; interruptible.
 #pragma once
 
 #include <openvdb/openvdb.h>

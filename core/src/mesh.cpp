@@ -202,8 +202,8 @@ Mesh bakeMesh(const Params& params, const BakeOptions& options, const ProgressCa
     validate(params);
     initializeOpenVdb();
     StagedProgress staged(progress, options.monitor);
-    // The surface function itself is meshed: the bake's level set is the exact distance to this
-    // very mesh (levelSetRebuild), so the mesh and the VDB hold the same surface.
+    // The surface function itself is meshed: the bake's level set is the distance to this very
+    // mesh (mesh_distance.hpp), so the mesh and the VDB hold the same surface.
     SampledSurface sampled = sampleSurface(params, options, meshMemoryModel(), staged, 0.05, 0.8);
     BakeStats stats = sampled.stats;
 
