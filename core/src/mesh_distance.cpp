@@ -187,10 +187,11 @@ struct Homes {
 
 /// The near voxels of one leaf: within a voxel of the mesh, their signed distance and nearest point.
 struct NearLeaf {
-    std::unique_ptr<FloatLeaf> leaf;
-    std::vector<Coord> voxels;
-    std::vector<openvdb::Vec3f> points;
-    std::vector<std::uint32_t> triangles;  // prim * 2 + half
+    std::vector<std::uint16_t> offsets;    // in the leaf
+    std::vector<float> distances;          // signed, voxels
+    std::vector<openvdb::Vec3f> points;    // the nearest points
+    std::vector<std::uint32_t> triangles;  // theirs: prim * 2 + half
+    bool empty() const { return offsets.empty(); }
 };
 
 /// Two distances (squared) this close are the same point of the mesh reached from two triangles.
@@ -220,6 +221,8 @@ NearLeaf nearVoxels(const Mesh& mesh, const Homes& homes, std::uint64_t key,
             for (int y = from.y(); y <= to.y(); ++y)
                 for (int z = from.z(); z <= to.z(); ++z) {
                     const Vec3d voxel(x, y, z);
+                    // Farther than a voxel from the triangle's plane: farther from the triangle.
+                    if (area > 0.0 && std::abs(normal.dot(voxel - t.a)) > 1.0) continue;
                     const Vec3d point = closestPointOnTriangle(voxel, t);
                     const Vec3d away = voxel - point;
                     const double squared = away.lengthSqr();
@@ -250,13 +253,12 @@ NearLeaf nearVoxels(const Mesh& mesh, const Homes& homes, std::uint64_t key,
     NearLeaf result;
     for (std::size_t offset = 0; offset < FloatLeaf::SIZE; ++offset) {
         if (!(best[offset] <= 1.0)) continue;
-        if (!result.leaf) result.leaf = std::make_unique<FloatLeaf>(origin, 0.0f, false);
         const Coord voxel = FloatLeaf::offsetToLocalCoord(openvdb::Index(offset)) + origin;
         // volumeToMesh's faces turn their front (b - a) x (c - a) outwards, to f > 0.
         const bool inside = facing[offset] != 0.0 ? facing[offset] < 0.0 : f.getValue(voxel) < 0.0f;
         const double distance = std::sqrt(best[offset]);
-        result.leaf->setValueOn(openvdb::Index(offset), float(inside ? -distance : distance));
-        result.voxels.push_back(voxel);
+        result.offsets.push_back(std::uint16_t(offset));
+        result.distances.push_back(float(inside ? -distance : distance));
         result.points.emplace_back(nearest[offset]);
         result.triangles.push_back(nearestTriangle[offset]);
     }
@@ -285,6 +287,9 @@ struct BandBlock {
     std::size_t at(int x, int y, int z) const { return std::size_t((x * side + y) * side + z); }
 };
 
+/// Not a near voxel.
+constexpr float kFar = std::numeric_limits<float>::infinity();
+
 template <typename NearLookup>
 std::unique_ptr<FloatLeaf> bandLeaf(BandBlock& block, const Coord& origin, int reach, float band, float voxelSize,
                                     const Mesh& mesh, const NearLookup& nearLeaf,
@@ -299,15 +304,16 @@ std::unique_ptr<FloatLeaf> bandLeaf(BandBlock& block, const Coord& origin, int r
             for (int z = low; z < high; ++z) seeds[block.at(x, y, z)] = -1;
     block.points.clear();
     block.triangles.clear();
-    const FloatLeaf* own = nullptr;
+    const NearLeaf* own = nullptr;
     for (int dx = -around; dx <= around; ++dx)
         for (int dy = -around; dy <= around; ++dy)
             for (int dz = -around; dz <= around; ++dz) {
                 const NearLeaf* leaf = nearLeaf(leafKey(origin.offsetBy(dx * kDim, dy * kDim, dz * kDim)));
                 if (!leaf) continue;
-                if (dx == 0 && dy == 0 && dz == 0) own = leaf->leaf.get();
-                for (std::size_t n = 0; n < leaf->voxels.size(); ++n) {
-                    const Coord cell = leaf->voxels[n] - origin + Coord(pad);
+                if (dx == 0 && dy == 0 && dz == 0) own = leaf;
+                const Coord corner = Coord(dx * kDim, dy * kDim, dz * kDim) + Coord(pad);
+                for (std::size_t n = 0; n < leaf->offsets.size(); ++n) {
+                    const Coord cell = FloatLeaf::offsetToLocalCoord(leaf->offsets[n]) + corner;
                     if (cell.x() < low || cell.y() < low || cell.z() < low || cell.x() >= high || cell.y() >= high ||
                         cell.z() >= high)
                         continue;
@@ -317,6 +323,10 @@ std::unique_ptr<FloatLeaf> bandLeaf(BandBlock& block, const Coord& origin, int r
                 }
             }
     if (block.points.empty()) return nullptr;
+    std::array<float, FloatLeaf::SIZE> nearHere;
+    nearHere.fill(kFar);
+    if (own)
+        for (std::size_t n = 0; n < own->offsets.size(); ++n) nearHere[own->offsets[n]] = own->distances[n];
     const openvdb::Vec3f base = (origin - Coord(pad)).asVec3s();
     // One pass: each cell of [from, to) takes the nearest to it of the seeds `reach` cells
     // either side of it along `axis` in `in`.
@@ -353,8 +363,8 @@ std::unique_ptr<FloatLeaf> bandLeaf(BandBlock& block, const Coord& origin, int r
     for (openvdb::Index offset = 0; offset < FloatLeaf::SIZE; ++offset) {
         const Coord local = FloatLeaf::offsetToLocalCoord(offset);
         float distance = band;
-        if (own && own->isValueOn(offset)) {
-            distance = own->getValue(offset);
+        if (nearHere[offset] != kFar) {
+            distance = nearHere[offset];
         } else {
             const std::int32_t seed = rows[block.at(local.x() + pad, local.y() + pad, local.z() + pad)];
             if (seed >= 0) {
@@ -430,14 +440,14 @@ openvdb::FloatGrid::Ptr levelSetOfMesh(const openvdb::FloatGrid& f, float bandWi
         const auto at = std::lower_bound(leaves.begin(), leaves.end(), key);
         if (at == leaves.end() || *at != key) return nullptr;
         const NearLeaf& leaf = near[std::size_t(at - leaves.begin())];
-        return leaf.leaf ? &leaf : nullptr;
+        return leaf.empty() ? nullptr : &leaf;
     };
     // The band's leaves: those within the band's reach of the near voxels' leaves.
     const float band = std::max(bandWidth, 0.0f);
     const int reach = int(std::ceil(band)), around = (reach + kDim - 1) / kDim;
     std::vector<std::uint64_t> bandLeaves;
     for (std::size_t k = 0; k < leaves.size(); ++k) {
-        if (!near[k].leaf) continue;
+        if (near[k].empty()) continue;
         const Coord origin = leafOrigin(leaves[k]);
         for (int dx = -around; dx <= around; ++dx)
             for (int dy = -around; dy <= around; ++dy)
