@@ -129,22 +129,25 @@ Coord leafOrigin(std::uint64_t key) {
     return {part(key >> 42), part(key >> 21), part(key)};
 }
 
-/// Quads span at most 2 x 2 x 1 cells, so each is looked for only around its first vertex's
-/// leaf; the rare larger primitive (more than this many voxels across) is tested by every leaf.
-constexpr double kLocalExtent = 4.0;
+/// The bit of a leaf's neighbour (each of dx, dy, dz in -1..1) in a 27-bit set of leaves.
+constexpr std::uint32_t neighbourBit(int dx, int dy, int dz) { return 1u << ((dx + 1) * 9 + (dy + 1) * 3 + dz + 1); }
 
-/// The primitives of each leaf ("home": its first vertex's leaf), sorted by the leaf's key.
+/// The primitives of each leaf ("home": its first vertex's leaf), sorted by the leaf's key, and
+/// which of the home's neighbour leaves each one's box grown by a voxel reaches. Quads span at
+/// most 2 x 2 x 1 cells, so they reach only their home's neighbours; the rare primitive that
+/// reaches farther is "large" and tested by every leaf.
 struct Homes {
     std::vector<std::uint64_t> keys;  // the leaves that are homes, sorted
     std::vector<std::size_t> start;   // prims of keys[k]: order[start[k]] .. order[start[k + 1]]
     std::vector<std::uint32_t> order;
+    std::vector<std::uint32_t> reaches;  // order[i]'s neighbour leaves (neighbourBit)
     std::vector<std::uint32_t> large;
 
     Homes(const Mesh& mesh) {
         if (mesh.prims.size() >= std::size_t(std::numeric_limits<std::uint32_t>::max()))
             throw std::length_error("levelSetOfMesh: too many polygons");
         std::vector<std::pair<std::uint64_t, std::uint32_t>> byKey(mesh.prims.size());
-        std::vector<char> isLarge(mesh.prims.size(), 0);
+        std::vector<std::uint32_t> reach(mesh.prims.size(), 0);  // 0: large
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.prims.size()),
                           [&](const tbb::blocked_range<std::size_t>& range) {
                               for (std::size_t prim = range.begin(); prim != range.end(); ++prim) {
@@ -154,14 +157,27 @@ struct Homes {
                                       low = openvdb::math::minComponent(low, mesh.points[v[k]]);
                                       high = openvdb::math::maxComponent(high, mesh.points[v[k]]);
                                   }
-                                  isLarge[prim] = (high - low).length() > kLocalExtent;
-                                  byKey[prim] = {leafKey(Coord::floor(mesh.points[v[0]])), std::uint32_t(prim)};
+                                  const Coord home = Coord::floor(mesh.points[v[0]]);
+                                  Coord from, to;
+                                  bool local = true;
+                                  for (int axis = 0; axis < 3; ++axis) {
+                                      const int origin = home[axis] & ~(kDim - 1);
+                                      from[axis] = (int(std::ceil(low[axis] - 1.0f)) - origin) >> 3;
+                                      to[axis] = (int(std::floor(high[axis] + 1.0f)) - origin) >> 3;
+                                      local = local && from[axis] >= -1 && to[axis] <= 1;
+                                  }
+                                  std::uint32_t bits = 0;
+                                  for (int dx = from.x(); local && dx <= to.x(); ++dx)
+                                      for (int dy = from.y(); dy <= to.y(); ++dy)
+                                          for (int dz = from.z(); dz <= to.z(); ++dz) bits |= neighbourBit(dx, dy, dz);
+                                  reach[prim] = bits;
+                                  byKey[prim] = {leafKey(home), std::uint32_t(prim)};
                               }
                           });
         tbb::parallel_sort(byKey.begin(), byKey.end());
         order.reserve(byKey.size());
         for (std::size_t k = 0; k < byKey.size(); ++k) {
-            if (isLarge[byKey[k].second]) {
+            if (reach[byKey[k].second] == 0) {
                 large.push_back(byKey[k].second);
                 continue;
             }
@@ -170,18 +186,21 @@ struct Homes {
                 start.push_back(order.size());
             }
             order.push_back(byKey[k].second);
+            reaches.push_back(reach[byKey[k].second]);
         }
         start.push_back(order.size());
         std::sort(large.begin(), large.end());
     }
 
-    /// Calls `visit(prim)` for each primitive homed in the leaf of `key`.
+    /// Calls `visit(prim)` for each primitive homed in the leaf of `key` that reaches the
+    /// home's neighbour `bit`.
     template <typename Visit>
-    void forEachIn(std::uint64_t key, Visit&& visit) const {
+    void forEachIn(std::uint64_t key, std::uint32_t bit, Visit&& visit) const {
         const auto at = std::lower_bound(keys.begin(), keys.end(), key);
         if (at == keys.end() || *at != key) return;
         const std::size_t k = std::size_t(at - keys.begin());
-        for (std::size_t i = start[k]; i != start[k + 1]; ++i) visit(order[i]);
+        for (std::size_t i = start[k]; i != start[k + 1]; ++i)
+            if (reaches[i] & bit) visit(order[i]);
     }
 };
 
@@ -247,7 +266,8 @@ NearLeaf nearVoxels(const Mesh& mesh, const Homes& homes, std::uint64_t key,
     for (int dx = -1; dx <= 1; ++dx)
         for (int dy = -1; dy <= 1; ++dy)
             for (int dz = -1; dz <= 1; ++dz)
-                homes.forEachIn(leafKey(origin.offsetBy(dx * kDim, dy * kDim, dz * kDim)), test);
+                homes.forEachIn(leafKey(origin.offsetBy(dx * kDim, dy * kDim, dz * kDim)), neighbourBit(-dx, -dy, -dz),
+                                test);
     for (std::uint32_t prim : homes.large) test(prim);
 
     NearLeaf result;
@@ -330,28 +350,41 @@ std::unique_ptr<FloatLeaf> bandLeaf(BandBlock& block, const Coord& origin, int r
     const openvdb::Vec3f base = (origin - Coord(pad)).asVec3s();
     // One pass: each cell of [from, to) takes the nearest to it of the seeds `reach` cells
     // either side of it along `axis` in `in`.
+    // Lines without a seed (most, where the surface runs along them) are skipped.
     auto pass = [&](const std::vector<std::int32_t>& in, std::vector<std::int32_t>& result, int axis, const Coord& from,
                     const Coord& to) {
-        for (int x = from.x(); x < to.x(); ++x)
-            for (int y = from.y(); y < to.y(); ++y)
-                for (int z = from.z(); z < to.z(); ++z) {
-                    const openvdb::Vec3f centre = base + openvdb::Vec3f(float(x), float(y), float(z));
+        const int across = (axis + 1) % 3, along = (axis + 2) % 3;
+        const std::size_t stride =
+            axis == 0 ? std::size_t(block.side) * std::size_t(block.side) : (axis == 1 ? std::size_t(block.side) : 1);
+        const int cells = to[axis] - from[axis], length = cells + 2 * reach;
+        for (int u = from[across]; u < to[across]; ++u)
+            for (int w = from[along]; w < to[along]; ++w) {
+                Coord cell;
+                cell[across] = u;
+                cell[along] = w;
+                cell[axis] = from[axis] - reach;
+                const std::size_t first = block.at(cell.x(), cell.y(), cell.z());
+                bool any = false;
+                for (int k = 0; k < length && !any; ++k) any = in[first + std::size_t(k) * stride] >= 0;
+                for (int c = 0; c < cells; ++c) {
                     std::int32_t best = -1;
-                    float nearest = std::numeric_limits<float>::infinity();
-                    Coord cell(x, y, z);
-                    const int middle = cell[axis];
-                    for (int step = -reach; step <= reach; ++step) {
-                        cell[axis] = middle + step;
-                        const std::int32_t seed = in[block.at(cell.x(), cell.y(), cell.z())];
-                        if (seed < 0) continue;
-                        const float squared = (block.points[std::size_t(seed)] - centre).lengthSqr();
-                        if (squared < nearest) {
-                            nearest = squared;
-                            best = seed;
+                    if (any) {
+                        cell[axis] = from[axis] + c;
+                        const openvdb::Vec3f centre = base + cell.asVec3s();
+                        float nearest = std::numeric_limits<float>::infinity();
+                        for (int k = c; k <= c + 2 * reach; ++k) {
+                            const std::int32_t seed = in[first + std::size_t(k) * stride];
+                            if (seed < 0) continue;
+                            const float squared = (block.points[std::size_t(seed)] - centre).lengthSqr();
+                            if (squared < nearest) {
+                                nearest = squared;
+                                best = seed;
+                            }
                         }
                     }
-                    result[block.at(x, y, z)] = best;
+                    result[first + std::size_t(c + reach) * stride] = best;
                 }
+            }
     };
     const Coord inner(pad), outer(pad + kDim);
     pass(seeds, rows, 0, Coord(inner.x(), low, low), Coord(outer.x(), high, high));
