@@ -3,7 +3,9 @@
 # imported target dqj::<name> naming its archive by path, so nothing of the system's shared
 # OpenVDB, TBB or OpenEXR can slip into the link.
 #
-#   dqj::zlib dqj::png dqj::imath dqj::openexr dqj::tbb dqj::hwy dqj::openvdb
+#   dqj::zlib dqj::png dqj::imath dqj::openexr dqj::tbb dqj::hwy dqj::lz4 dqj::blosc dqj::openvdb
+#
+# (c-blosc, with LZ4 and zlib as its codecs, is OpenVDB's Blosc compression of the files it writes.)
 #
 # The global property DQJ_STATIC_DEPENDENCY_ARCHIVES lists their archives' file names (for
 # the linker's --exclude-libs).
@@ -59,5 +61,7 @@ else()
   set(dqj_openvdb_defines)
 endif()
 dqj_static_dependency(hwy ARCHIVES libhwy.a DEFINES HWY_STATIC_DEFINE)
-dqj_static_dependency(openvdb ARCHIVES libopenvdb.a LINKS dqj::tbb dqj::imath dqj::zlib Threads::Threads
+dqj_static_dependency(lz4 ARCHIVES liblz4.a)
+dqj_static_dependency(blosc ARCHIVES libblosc.a LINKS dqj::lz4 dqj::zlib Threads::Threads)
+dqj_static_dependency(openvdb ARCHIVES libopenvdb.a LINKS dqj::tbb dqj::imath dqj::blosc dqj::zlib Threads::Threads
                       DEFINES ${dqj_openvdb_defines})

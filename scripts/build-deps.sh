@@ -4,7 +4,12 @@
 # outside the checkout:
 #
 #   zlib 1.2.13, libpng 1.6.39, Imath 3.1.6, OpenEXR 3.1.5, oneTBB 2021.8.0,
-#   Highway 1.0.3, OpenVDB 10.0.1 (no Blosc, no delayed loading: no Boost libraries)
+#   Highway 1.0.3, LZ4 1.9.4, c-blosc 1.21.3, OpenVDB 10.0.1 (with Blosc; no delayed loading:
+#   no Boost libraries)
+#
+# Debian's c-blosc source ("1.21.3+ds") has its bundled codecs stripped: it is built against
+# our LZ4 (Debian's lz4 source; the codec OpenVDB's Blosc compression uses) and zlib, without
+# Zstd and Snappy, which OpenVDB never writes (Debian's libblosc1 links all four).
 #
 # for Linux x86-64 (position-independent), or for Windows x64 with MinGW-w64
 # (cmake/toolchains/mingw-w64-x86_64.cmake), where the command's and the tests' other libraries
@@ -39,12 +44,12 @@ while [ $# -gt 0 ]; do
 done
 
 here=$(cd "$(dirname "$0")" && pwd)
-versions="zlib-1.2.13_png-1.6.39_imath-3.1.6_exr-3.1.5_tbb-2021.8.0_hwy-1.0.3_vdb-10.0.1"
+versions="zlib-1.2.13_png-1.6.39_imath-3.1.6_exr-3.1.5_tbb-2021.8.0_hwy-1.0.3_lz4-1.9.4_blosc-1.21.3_vdb-10.0.1"
 case "$target" in
-  linux-x64) recipe=1 ;;  # bump when the build options below change
+  linux-x64) recipe=2 ;;  # bump when the build options below change
   windows-x64)
     versions="${versions}_ft-2.12.1_gtest-1.12.1_glm-0.9.9.8_json-3.11.2_cli11-2.1.2"
-    recipe=5 ;;
+    recipe=6 ;;
   *) echo "dqjulia deps: unknown target '$target' (linux-x64 or windows-x64)" >&2; exit 2 ;;
 esac
 key="${versions}_r${recipe}"
@@ -113,6 +118,8 @@ fetch imath 'imath_3.1.6.orig.tar.*'
 fetch openexr 'openexr_3.1.5.orig.tar.*'
 fetch onetbb 'onetbb_2021.8.0.orig.tar.*'
 fetch highway 'highway_1.0.3.orig.tar.*'
+fetch lz4 'lz4_1.9.4.orig.tar.*'
+fetch c-blosc 'c-blosc_1.21.3*.orig.tar.*'
 fetch openvdb 'openvdb_10.0.1.orig.tar.*'
 if [ "$target" = windows-x64 ]; then
   fetch freetype 'freetype_2.12.1*.orig.tar.*'
@@ -148,6 +155,15 @@ zlib_env=(CFLAGS="-O2 -fPIC")
 log "built zlib"
 zlib_opts=("-DZLIB_ROOT=$stage" "-DZLIB_LIBRARY=$stage/lib/libz.a" "-DZLIB_INCLUDE_DIR=$stage/include")
 
+# LZ4: its own Makefile's static archive alone (its CMake builds the command too), for c-blosc.
+lz4_env=(CFLAGS="-O2 -fPIC")
+[ "$target" = windows-x64 ] && lz4_env=(CC=$mingw-gcc-posix AR=$mingw-ar CFLAGS="-O2")
+(cd "$work/src/lz4/lib" && env "${lz4_env[@]}" make -j"$jobs" liblz4.a >"$work/lz4.log" 2>&1 \
+  && mkdir -p "$stage/lib" "$stage/include" && cp liblz4.a "$stage/lib/" \
+  && cp lz4.h lz4hc.h lz4frame.h "$stage/include/") \
+  || { tail -n 40 "$work/lz4.log" >&2; echo "dqjulia deps: building lz4 failed" >&2; exit 1; }
+log "built lz4"
+
 openvdb_opts=()
 if [ "$target" = windows-x64 ]; then
   # OpenVDB's headers include Boost's (header-only here): the system's, through a link in the
@@ -182,9 +198,31 @@ if [ "$target" = windows-x64 ]; then
 fi
 build highway -DHWY_ENABLE_TESTS=OFF -DHWY_ENABLE_EXAMPLES=OFF -DHWY_ENABLE_CONTRIB=OFF -DHWY_ENABLE_INSTALL=ON \
   -DHWY_FORCE_STATIC_LIBS=ON -DBUILD_TESTING=OFF
+# c-blosc with our LZ4 and zlib named by path (the system's libblosc-dev or liblz4 must not be
+# found), static only, its symbols hidden (HIDE_SYMBOLS: no export attribute in a static build).
+# MinGW: its shuffle.c calls _xgetbv (behind a CPUID check), an intrinsic GCC allows only with
+# -mxsave (CFLAGS joins the toolchain's flags rather than replacing them).
+blosc_cflags=
+[ "$target" = windows-x64 ] && blosc_cflags=-mxsave
+CFLAGS=$blosc_cflags build c-blosc "${zlib_opts[@]}" -DBUILD_SHARED=OFF -DBUILD_STATIC=ON -DBUILD_TESTS=OFF \
+  -DBUILD_FUZZERS=OFF -DBUILD_BENCHMARKS=OFF -DHIDE_SYMBOLS=ON -DPREFER_EXTERNAL_LZ4=ON \
+  "-DLZ4_INCLUDE_DIR=$stage/include" "-DLZ4_LIBRARY=$stage/lib/liblz4.a" -DPREFER_EXTERNAL_ZLIB=ON \
+  -DDEACTIVATE_ZSTD=ON -DDEACTIVATE_SNAPPY=ON
+if [ "$target" = windows-x64 ]; then
+  # On Windows blosc.c compiles in its own pthread_create and pthread_cond_* (win32/pthread.c),
+  # global symbols that would clash with winpthreads' in a static link: renamed in the archive.
+  renames=()
+  for sym in die pthread_create pthread_cond_init pthread_cond_destroy pthread_cond_wait pthread_cond_signal \
+             pthread_cond_broadcast win32_pthread_join; do
+    renames+=(--redefine-sym "$sym=dqj_blosc_$sym")
+  done
+  $mingw-objcopy "${renames[@]}" "$stage/lib/libblosc.a"
+fi
 build openvdb "${zlib_opts[@]}" "-DTBB_ROOT=$stage" -DOPENVDB_CORE_SHARED=OFF -DOPENVDB_CORE_STATIC=ON \
   -DOPENVDB_BUILD_BINARIES=OFF -DOPENVDB_BUILD_PYTHON_MODULE=OFF -DOPENVDB_BUILD_UNITTESTS=OFF \
-  -DOPENVDB_BUILD_DOCS=OFF -DUSE_BLOSC=OFF -DUSE_ZLIB=ON -DUSE_EXPLICIT_INSTANTIATION=OFF \
+  -DOPENVDB_BUILD_DOCS=OFF -DUSE_BLOSC=ON "-DBlosc_ROOT=$stage" "-DBlosc_INCLUDE_DIR=$stage/include" \
+  "-DBlosc_LIBRARY_RELEASE=$stage/lib/libblosc.a" "-DBlosc_LIBRARY_DEBUG=$stage/lib/libblosc.a" -DUSE_ZLIB=ON \
+  -DUSE_EXPLICIT_INSTANTIATION=OFF \
   -DOPENVDB_USE_DELAYED_LOADING=OFF -DUSE_PKGCONFIG=OFF "${openvdb_opts[@]}"
 
 if [ "$target" = windows-x64 ]; then

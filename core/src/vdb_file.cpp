@@ -12,6 +12,11 @@
 
 #include "file_names.hpp"
 
+// Without Blosc, OpenVDB would throw only at the first leaf it compresses, in every bake.
+#ifndef OPENVDB_USE_BLOSC
+#error "dqjulia writes Blosc-compressed VDB files: OpenVDB must be built with Blosc (scripts/build-deps.sh)"
+#endif
+
 namespace dqj {
 namespace {
 
@@ -89,6 +94,7 @@ std::string shortMessage(const std::string& text) {
 /// Archive's seekable stream writer is what io::File::write calls, so the bytes are the same.
 class CheckedVdbWriter : public openvdb::io::Archive {
 public:
+    explicit CheckedVdbWriter(std::uint32_t compression) { setCompression(compression); }
     void writeTo(std::ostream& out, const openvdb::GridPtrVec& grids, const openvdb::MetaMap& metadata) const {
         openvdb::io::Archive::write(out, grids, /*seekable=*/true, metadata);
     }
@@ -159,9 +165,19 @@ openvdb::GridBase::Ptr findGrid(const VdbContents& contents, const std::string& 
     return nullptr;
 }
 
-void writeVdbFile(AtomicFile& file, const openvdb::GridPtrVec& grids, const openvdb::MetaMap& metadata) {
+std::uint32_t vdbCompressionFlags(VdbCompression compression) {
+    switch (compression) {
+        case VdbCompression::Blosc: return openvdb::io::COMPRESS_BLOSC | openvdb::io::COMPRESS_ACTIVE_MASK;
+        case VdbCompression::Zip: return openvdb::io::COMPRESS_ZIP | openvdb::io::COMPRESS_ACTIVE_MASK;
+        case VdbCompression::None: break;
+    }
+    return openvdb::io::COMPRESS_ACTIVE_MASK;
+}
+
+void writeVdbFile(AtomicFile& file, const openvdb::GridPtrVec& grids, const openvdb::MetaMap& metadata,
+                  VdbCompression compression) {
     try {
-        CheckedVdbWriter().writeTo(file.stream(), grids, metadata);
+        CheckedVdbWriter(vdbCompressionFlags(compression)).writeTo(file.stream(), grids, metadata);
     } catch (const openvdb::Exception& error) {
         if (!file.stream()) file.commit();  // throws with the write's reason ("No space left on device")
         throw std::runtime_error(AtomicFile::failureMessage(file.path(), error.what()));
