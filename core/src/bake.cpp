@@ -244,7 +244,7 @@ openvdb::FloatGrid::Ptr bakeLevelSet(const Params& params, const BakeOptions& op
     openvdb::FloatGrid::Ptr surface;
     parallelForWithProgress(1, progress.stage(BakeStage::LevelSet, sampledAt, rebuiltAt),
                             [&](std::size_t, const std::atomic<bool>& stop) {
-                                surface = levelSetOfMesh(*sampled.grid, band, stop);
+                                surface = levelSetOfMesh(std::move(sampled.grid), band, stop);
                             });
     sampled.grid.reset();
     surface->setName("surface");

@@ -19,6 +19,7 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_sort.h>
 
+#include "sparse_sampler.hpp"
 #include "thread_scratch.hpp"
 
 namespace dqj {
@@ -217,7 +218,7 @@ struct NearLeaf {
 constexpr double kTie = 1e-9;
 
 NearLeaf nearVoxels(const Mesh& mesh, const Homes& homes, std::uint64_t key,
-                    openvdb::tree::ValueAccessor<const openvdb::FloatTree>& f) {
+                    openvdb::tree::ValueAccessor<const openvdb::BoolTree>& inside) {
     const Coord origin = leafOrigin(key);
     std::array<double, FloatLeaf::SIZE> best;
     std::array<double, FloatLeaf::SIZE> facing{};  // the nearest triangles' normal against the way to the voxel
@@ -275,10 +276,10 @@ NearLeaf nearVoxels(const Mesh& mesh, const Homes& homes, std::uint64_t key,
         if (!(best[offset] <= 1.0)) continue;
         const Coord voxel = FloatLeaf::offsetToLocalCoord(openvdb::Index(offset)) + origin;
         // volumeToMesh's faces turn their front (b - a) x (c - a) outwards, to f > 0.
-        const bool inside = facing[offset] != 0.0 ? facing[offset] < 0.0 : f.getValue(voxel) < 0.0f;
+        const bool in = facing[offset] != 0.0 ? facing[offset] < 0.0 : inside.getValue(voxel);
         const double distance = std::sqrt(best[offset]);
         result.offsets.push_back(std::uint16_t(offset));
-        result.distances.push_back(float(inside ? -distance : distance));
+        result.distances.push_back(float(in ? -distance : distance));
         result.points.emplace_back(nearest[offset]);
         result.triangles.push_back(nearestTriangle[offset]);
     }
@@ -313,7 +314,7 @@ constexpr float kFar = std::numeric_limits<float>::infinity();
 template <typename NearLookup>
 std::unique_ptr<FloatLeaf> bandLeaf(BandBlock& block, const Coord& origin, int reach, float band, float voxelSize,
                                     const Mesh& mesh, const NearLookup& nearLeaf,
-                                    openvdb::tree::ValueAccessor<const openvdb::FloatTree>& f) {
+                                    openvdb::tree::ValueAccessor<const openvdb::BoolTree>& inside) {
     if (block.side == 0) block.reach(reach);
     const int pad = block.pad, around = block.leaves;
     const int low = pad - reach, high = pad + kDim + reach;  // the block's cells in use: [low, high)
@@ -406,7 +407,7 @@ std::unique_ptr<FloatLeaf> bandLeaf(BandBlock& block, const Coord& origin, int r
                 distance = float(
                     (voxel - closestPointOnTriangle(voxel, mesh.triangle(triangle / 2, int(triangle % 2)))).length());
             }
-            if (f.getValue(origin + local) < 0.0f) distance = -distance;
+            if (inside.getValue(origin + local)) distance = -distance;
         }
         // Every voxel's sign is set here (signedFloodFill would give the inactive ones the sign
         // of the active voxel before them in the leaf, wrong beside the band's gaps).
@@ -420,12 +421,43 @@ std::unique_ptr<FloatLeaf> bandLeaf(BandBlock& block, const Coord& origin, int r
     return active ? std::move(leaf) : nullptr;
 }
 
+/// Where f < 0: f's leaves' signs and its inside tiles, a bit a voxel (f itself is 32).
+openvdb::BoolTree::Ptr insideOf(const openvdb::FloatTree& f) {
+    using BoolLeaf = openvdb::BoolTree::LeafNodeType;
+    std::vector<const FloatLeaf*> leaves;
+    leaves.reserve(f.leafCount());
+    f.getNodes(leaves);
+    std::vector<BoolLeaf*> signs(leaves.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()),
+                      [&](const tbb::blocked_range<std::size_t>& range) {
+                          for (std::size_t k = range.begin(); k != range.end(); ++k) {
+                              signs[k] = new BoolLeaf(leaves[k]->origin(), false);
+                              const float* values = leaves[k]->buffer().data();
+                              for (openvdb::Index offset = 0; offset < FloatLeaf::SIZE; ++offset)
+                                  if (values[offset] < 0.0f) signs[k]->setValueOnly(offset, true);
+                          }
+                      });
+    auto inside = std::make_shared<openvdb::BoolTree>(false);
+    for (BoolLeaf* leaf : signs) inside->addLeaf(leaf);
+    auto tile = f.cbeginValueAll();
+    tile.setMaxDepth(openvdb::FloatTree::ValueAllCIter::LEAF_DEPTH - 1);  // the tiles, not the leaves' voxels
+    for (; tile; ++tile)
+        if (*tile < 0.0f) inside->addTile(tile.getLevel(), tile.getCoord(), true, false);
+    return inside;
+}
+
 }  // namespace
 
-openvdb::FloatGrid::Ptr levelSetOfMesh(const openvdb::FloatGrid& f, float bandWidth, const std::atomic<bool>& stop) {
-    const Mesh mesh = meshOf(f);
+openvdb::FloatGrid::Ptr levelSetOfMesh(openvdb::FloatGrid::Ptr f, float bandWidth, const std::atomic<bool>& stop) {
+    const Mesh mesh = meshOf(*f);
+    const openvdb::BoolTree::Ptr inside = insideOf(f->tree());
+    const openvdb::math::Transform::Ptr transform = f->transform().copy();
+    const float voxelSize = float(f->voxelSize()[0]);
+    f.reset();  // the caller's copy too, if it moved it here: its memory is the band's
+    releaseFreedMemory();
     if (stop) return nullptr;
     const Homes homes(mesh);
+    releaseFreedMemory();
 
     // The leaves that may hold near voxels: the homes and their neighbours.
     std::vector<std::uint64_t> leaves;
@@ -460,13 +492,26 @@ openvdb::FloatGrid::Ptr levelSetOfMesh(const openvdb::FloatGrid& f, float bandWi
     std::vector<NearLeaf> near(leaves.size());
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size(), 16),
                       [&](const tbb::blocked_range<std::size_t>& range) {
-                          openvdb::tree::ValueAccessor<const openvdb::FloatTree> accessor(f.tree());
+                          openvdb::tree::ValueAccessor<const openvdb::BoolTree> accessor(*inside);
                           for (std::size_t k = range.begin(); k != range.end(); ++k) {
                               if (stop.load(std::memory_order_relaxed)) return;
                               near[k] = nearVoxels(mesh, homes, leaves[k], accessor);
                           }
                       });
     if (stop) return nullptr;
+    {  // only the leaves that have near voxels (the others are most)
+        std::size_t kept = 0;
+        for (std::size_t k = 0; k < leaves.size(); ++k)
+            if (!near[k].empty()) {
+                leaves[kept] = leaves[k];
+                near[kept++] = std::move(near[k]);
+            }
+        leaves.resize(kept);
+        leaves.shrink_to_fit();
+        near.resize(kept);
+        near.shrink_to_fit();
+    }
+    releaseFreedMemory();
 
     // The near voxels' leaves, by key (`leaves` is sorted).
     auto nearLeaf = [&](std::uint64_t key) -> const NearLeaf* {
@@ -480,7 +525,6 @@ openvdb::FloatGrid::Ptr levelSetOfMesh(const openvdb::FloatGrid& f, float bandWi
     const int reach = int(std::ceil(band)), around = (reach + kDim - 1) / kDim;
     std::vector<std::uint64_t> bandLeaves;
     for (std::size_t k = 0; k < leaves.size(); ++k) {
-        if (near[k].empty()) continue;
         const Coord origin = leafOrigin(leaves[k]);
         for (int dx = -around; dx <= around; ++dx)
             for (int dy = -around; dy <= around; ++dy)
@@ -490,17 +534,16 @@ openvdb::FloatGrid::Ptr levelSetOfMesh(const openvdb::FloatGrid& f, float bandWi
     tbb::parallel_sort(bandLeaves.begin(), bandLeaves.end());
     bandLeaves.erase(std::unique(bandLeaves.begin(), bandLeaves.end()), bandLeaves.end());
 
-    const float voxelSize = float(f.voxelSize()[0]);
     std::vector<std::unique_ptr<FloatLeaf>> out(bandLeaves.size());
     ThreadScratch<BandBlock> blocks;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, bandLeaves.size(), 16),
                       [&](const tbb::blocked_range<std::size_t>& range) {
-                          openvdb::tree::ValueAccessor<const openvdb::FloatTree> fValues(f.tree());
+                          openvdb::tree::ValueAccessor<const openvdb::BoolTree> insideValues(*inside);
                           BandBlock& block = blocks.local();
                           for (std::size_t k = range.begin(); k != range.end(); ++k) {
                               if (stop.load(std::memory_order_relaxed)) return;
                               out[k] = bandLeaf(block, leafOrigin(bandLeaves[k]), reach, band, voxelSize, mesh,
-                                                nearLeaf, fValues);
+                                                nearLeaf, insideValues);
                           }
                       });
     if (stop) return nullptr;
@@ -513,7 +556,7 @@ openvdb::FloatGrid::Ptr levelSetOfMesh(const openvdb::FloatGrid& f, float bandWi
     openvdb::tools::pruneLevelSet(*tree);
 
     openvdb::FloatGrid::Ptr grid = openvdb::FloatGrid::create(tree);
-    grid->setTransform(f.transform().copy());
+    grid->setTransform(transform);
     grid->setGridClass(openvdb::GRID_LEVEL_SET);
     return grid;
 }

@@ -27,7 +27,9 @@ namespace dqj {
 
 /// The signed distance (world units, negative inside) to the mesh of f = 0, active where it is
 /// below `bandWidth` voxels, with f's transform; background +-bandWidth voxels, inside tiles
-/// negative. Returns nullptr when `stop` became true.
-openvdb::FloatGrid::Ptr levelSetOfMesh(const openvdb::FloatGrid& f, float bandWidth, const std::atomic<bool>& stop);
+/// negative. Once meshed, f is let go (freed if the caller moved its last pointer in), and only
+/// its signs are kept (a bit a voxel): the band's grids take its memory. Returns nullptr when
+/// `stop` became true.
+openvdb::FloatGrid::Ptr levelSetOfMesh(openvdb::FloatGrid::Ptr f, float bandWidth, const std::atomic<bool>& stop);
 
 }  // namespace dqj

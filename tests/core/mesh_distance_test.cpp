@@ -139,7 +139,7 @@ TEST(MeshDistance, TheLevelSetHoldsTheMeshOfF) {
     for (Case& c : cases()) {
         const openvdb::FloatGrid::Ptr f = sampled(c.params);
         const float band = float(c.params.bake.bandWidth);
-        const openvdb::FloatGrid::Ptr ours = levelSetOfMesh(*f, band, stop);
+        const openvdb::FloatGrid::Ptr ours = levelSetOfMesh(f, band, stop);
         const openvdb::FloatGrid::Ptr rebuilt = openvdb::tools::levelSetRebuild(*f, 0.0f, band, band);
         const MeshIndex meshOfF(*f), meshOfOurs(*ours), meshOfRebuilt(*rebuilt);
         const Farness oursToF = farness(meshOfOurs, meshOfF), fToOurs = farness(meshOfF, meshOfOurs);
@@ -183,7 +183,7 @@ TEST(MeshDistance, WideBandsHoldTheDistanceToTheBall) {
     for (float band : {1.0f, 3.0f, 12.0f}) {
         ball.bake.bandWidth = band;
         const openvdb::FloatGrid::Ptr f = sampled(ball);
-        const openvdb::FloatGrid::Ptr ours = levelSetOfMesh(*f, band, stop);
+        const openvdb::FloatGrid::Ptr ours = levelSetOfMesh(f, band, stop);
         const double h = f->voxelSize()[0];
         // f's sphere (within a voxel of the unit sphere): its mesh's vertices' mean radius.
         const MeshIndex meshOfF(*f);
