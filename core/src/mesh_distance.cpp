@@ -177,17 +177,17 @@ struct Homes {
                           });
         tbb::parallel_sort(byKey.begin(), byKey.end());
         order.reserve(byKey.size());
-        for (std::size_t k = 0; k < byKey.size(); ++k) {
-            if (reach[byKey[k].second] == 0) {
-                large.push_back(byKey[k].second);
+        for (const auto& [key, prim] : byKey) {
+            if (reach[prim] == 0) {
+                large.push_back(prim);
                 continue;
             }
-            if (keys.empty() || keys.back() != byKey[k].first) {
-                keys.push_back(byKey[k].first);
+            if (keys.empty() || keys.back() != key) {
+                keys.push_back(key);
                 start.push_back(order.size());
             }
-            order.push_back(byKey[k].second);
-            reaches.push_back(reach[byKey[k].second]);
+            order.push_back(prim);
+            reaches.push_back(reach[prim]);
         }
         start.push_back(order.size());
         std::sort(large.begin(), large.end());
@@ -305,7 +305,10 @@ struct BandBlock {
         side = kDim + 2 * pad;
         for (std::vector<std::int32_t>& c : cells) c.resize(std::size_t(side) * std::size_t(side) * std::size_t(side));
     }
-    std::size_t at(int x, int y, int z) const { return std::size_t((x * side + y) * side + z); }
+    std::size_t at(int x, int y, int z) const {
+        const auto n = std::size_t(side);
+        return (std::size_t(x) * n + std::size_t(y)) * n + std::size_t(z);
+    }
 };
 
 /// Not a near voxel.
@@ -524,8 +527,8 @@ openvdb::FloatGrid::Ptr levelSetOfMesh(openvdb::FloatGrid::Ptr f, float bandWidt
     const float band = std::max(bandWidth, 0.0f);
     const int reach = int(std::ceil(band)), around = (reach + kDim - 1) / kDim;
     std::vector<std::uint64_t> bandLeaves;
-    for (std::size_t k = 0; k < leaves.size(); ++k) {
-        const Coord origin = leafOrigin(leaves[k]);
+    for (const std::uint64_t key : leaves) {
+        const Coord origin = leafOrigin(key);
         for (int dx = -around; dx <= around; ++dx)
             for (int dy = -around; dy <= around; ++dy)
                 for (int dz = -around; dz <= around; ++dz)
