@@ -46,7 +46,7 @@ done
 here=$(cd "$(dirname "$0")" && pwd)
 versions="zlib-1.2.13_png-1.6.39_imath-3.1.6_exr-3.1.5_tbb-2021.8.0_hwy-1.0.3_lz4-1.9.4_blosc-1.21.3_vdb-10.0.1"
 case "$target" in
-  linux-x64) recipe=2 ;;  # bump when the build options below change
+  linux-x64) recipe=3 ;;  # bump when the build options below change
   windows-x64)
     versions="${versions}_ft-2.12.1_gtest-1.12.1_glm-0.9.9.8_json-3.11.2_cli11-2.1.2"
     recipe=6 ;;
@@ -198,6 +198,10 @@ if [ "$target" = windows-x64 ]; then
 fi
 build highway -DHWY_ENABLE_TESTS=OFF -DHWY_ENABLE_EXAMPLES=OFF -DHWY_ENABLE_CONTRIB=OFF -DHWY_ENABLE_INSTALL=ON \
   -DHWY_FORCE_STATIC_LIBS=ON -DBUILD_TESTING=OFF
+# batch.cpp's vector exp and log: the header-only hwy/contrib/math (the contrib libraries unbuilt;
+# Debian's libhwy-dev has it, a fresh machine does not).
+mkdir -p "$stage/include/hwy/contrib/math"
+cp "$work/src/highway/hwy/contrib/math/"*.h "$stage/include/hwy/contrib/math/"
 # c-blosc with our LZ4 and zlib named by path (the system's libblosc-dev or liblz4 must not be
 # found), static only, its symbols hidden (HIDE_SYMBOLS: no export attribute in a static build).
 # MinGW: its shuffle.c calls _xgetbv (behind a CPUID check), an intrinsic GCC allows only with
@@ -226,9 +230,6 @@ build openvdb "${zlib_opts[@]}" "-DTBB_ROOT=$stage" -DOPENVDB_CORE_SHARED=OFF -D
   -DOPENVDB_USE_DELAYED_LOADING=OFF -DUSE_PKGCONFIG=OFF "${openvdb_opts[@]}"
 
 if [ "$target" = windows-x64 ]; then
-  # batch.cpp's vector exp and log: the header-only hwy/contrib/math (the contrib libraries unbuilt).
-  mkdir -p "$stage/include/hwy/contrib/math"
-  cp "$work/src/highway/hwy/contrib/math/"*.h "$stage/include/hwy/contrib/math/"
   # FreeType with our zlib (without it, it compiles a copy of zlib in, whose symbols clash with it).
   build freetype "${zlib_opts[@]}" -DFT_REQUIRE_ZLIB=ON -DFT_DISABLE_BZIP2=ON -DFT_DISABLE_PNG=ON \
     -DFT_DISABLE_HARFBUZZ=ON -DFT_DISABLE_BROTLI=ON
