@@ -11,12 +11,14 @@ import os
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+from check_report import skip_or_fail  # noqa: E402 (tests/check_report.py)
+
 try:
     import numpy
     import pyopenvdb
 except ImportError as error:
-    print("DQJ_TEST_SKIPPED: pyopenvdb or numpy is missing (apt-get install python3-openvdb): %s" % error)
-    sys.exit(1 if os.environ.get("CI") == "true" else 0)
+    skip_or_fail("pyopenvdb or numpy is missing (apt-get install python3-openvdb python3-numpy): %s" % error)
 
 
 def main():
