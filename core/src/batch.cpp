@@ -5,11 +5,12 @@
 //
 // Every lane of a vector runs one point. Lanes that escape keep iterating with the others
 // (their values may overflow to inf or NaN, which is harmless) while their outputs are frozen
-// at the iteration they escaped; the vector stops when every lane has escaped or after N
-// iterations. In double precision the arithmetic repeats estimate.cpp's operations in the same
-// order without fused multiply-add (this file is compiled with -ffp-contract=off), so results
-// are bit-identical to evaluate() apart from the logarithm in the DE. In float, multiply-adds
-// are fused for speed.
+// at the iteration they escaped. A vector runs a segment of a few iterations; the orbits still
+// running after it are packed together, so a lane idles behind its vector's slowest point for
+// at most a segment (IterateChunk). In double precision the arithmetic repeats estimate.cpp's
+// operations in the same order without fused multiply-add (this file is compiled with
+// -ffp-contract=off), so results are bit-identical to evaluate() apart from the logarithm in
+// the DE. In float, multiply-adds are fused for speed.
 
 // clang-format off
 #undef HWY_TARGET_INCLUDE
@@ -19,10 +20,13 @@
 #include <hwy/contrib/math/math-inl.h>
 // clang-format on
 
+#include <algorithm>
+#include <bit>
 #include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <type_traits>
+#include <vector>
 
 #include "dqjulia/batch.hpp"
 
@@ -107,10 +111,52 @@ HWY_INLINE V PartEstimate(D d, V norm, V derivative) {
                           estimate);
 }
 
-/// One vector of points: loads lanes from `in` (8 arrays), stores the results to `out`
-/// (n as T, then r, ra, rb, de, trap), all at index 0 of the given pointers.
+/// One vector of orbits between iterations. Which fields carry over from one iteration to the
+/// next depends on the variant (Carried); the others are recomputed every iteration.
+template <class V>
+struct Orbit {
+    QuatV<V> a, b;
+    V ra, rb, r8, da, db, trap;
+};
+
+template <Variant Var>
+struct Carried {
+    static constexpr bool ra = Var != Variant::PaperCoupled;  // da's factor (paper, dual)
+    static constexpr bool rb = Var == Variant::Paper;         // db's factor
+    static constexpr bool r8 = Var == Variant::PaperCoupled;  // the 8-D dr's factor
+    static constexpr bool db = Var == Variant::Paper;
+};
+
+/// The outputs of a vector's lanes, frozen at the iteration each escaped.
+template <class V>
+struct Frozen {
+    V n, ra, rb, r8, da, db, trap;
+    QuatV<V> b;  // dual: b at escape (its norm is taken once, at the end)
+};
+
 template <Variant Var, class D, typename T = hn::TFromD<D>>
-HWY_INLINE void IterateVector(D d, const Constants<T>& constants, const T* const* in, T* const* out) {
+HWY_INLINE Orbit<hn::Vec<D>> StartOrbit(D d, const T* const* in, std::size_t at) {
+    using V = hn::Vec<D>;
+    Orbit<V> o;
+    o.a = {hn::LoadU(d, in[0] + at), hn::LoadU(d, in[1] + at), hn::LoadU(d, in[2] + at), hn::LoadU(d, in[3] + at)};
+    o.b = {hn::LoadU(d, in[4] + at), hn::LoadU(d, in[5] + at), hn::LoadU(d, in[6] + at), hn::LoadU(d, in[7] + at)};
+    o.ra = Norm(o.a);
+    o.rb = Norm(o.b);
+    // paper-coupled: the 8-D norm sqrt(ra^2 + rb^2), from the rounded ra and rb as estimate.cpp.
+    o.r8 = Var == Variant::PaperCoupled ? hn::Sqrt(MulAddT(o.rb, o.rb, hn::Mul(o.ra, o.ra))) : hn::Zero(d);
+    o.da = hn::Set(d, 1);  // paper, dual: |da|; paper-coupled: the 8-D dr
+    o.db = hn::Set(d, 1);
+    o.trap = o.ra;
+    return o;
+}
+
+/// Iterations from + 1 .. to of one vector of orbits. Lanes that escape join `escaped`, their
+/// outputs frozen in `frozen`; lanes already in it (escaped, or holding no orbit) are left alone.
+/// Escaped lanes keep iterating with the others (their values may overflow to inf or NaN,
+/// which is harmless); the vector stops early once every lane has escaped.
+template <Variant Var, class D, typename T = hn::TFromD<D>>
+HWY_INLINE void Iterate(D d, const Constants<T>& constants, Orbit<hn::Vec<D>>& o, int from, int to,
+                        hn::Mask<D>& escaped, Frozen<hn::Vec<D>>& frozen) {
     using V = hn::Vec<D>;
     V ca[4], cb[4];
     for (int k = 0; k < 4; ++k) {
@@ -119,142 +165,341 @@ HWY_INLINE void IterateVector(D d, const Constants<T>& constants, const T* const
     }
     const V bailout = hn::Set(d, constants.bailout);
     const V two = hn::Set(d, 2);
-
-    QuatV<V> a{hn::LoadU(d, in[0]), hn::LoadU(d, in[1]), hn::LoadU(d, in[2]), hn::LoadU(d, in[3])};
-    QuatV<V> b{hn::LoadU(d, in[4]), hn::LoadU(d, in[5]), hn::LoadU(d, in[6]), hn::LoadU(d, in[7])};
-    V ra = Norm(a);
-    V rb = Norm(b);
-    // paper-coupled: the 8-D norm sqrt(ra^2 + rb^2), from the rounded ra and rb as estimate.cpp.
-    V r8 = Var == Variant::PaperCoupled ? hn::Sqrt(MulAddT(rb, rb, hn::Mul(ra, ra))) : hn::Zero(d);
-    V da = hn::Set(d, 1);  // paper, dual: |da|; paper-coupled: the 8-D dr
-    V db = hn::Set(d, 1);
-    V trap = ra;
-
-    // Outputs of the lanes that escaped, frozen at their escape iteration.
-    auto escaped = hn::Lt(bailout, bailout);  // all false
-    V nOut = hn::Zero(d), raOut = nOut, rbOut = nOut, r8Out = nOut, daOut = nOut, dbOut = nOut, trapOut = nOut;
-    QuatV<V> bOut{nOut, nOut, nOut, nOut};  // dual: b at escape
-
-    for (int k = 1; k <= constants.iterations; ++k) {
+    for (int k = from + 1; k <= to; ++k) {
         if constexpr (Var == Variant::Paper) {
-            da = hn::Mul(da, hn::Mul(two, ra));
-            db = hn::Mul(db, hn::Mul(two, rb));
-            a = SquarePlus(d, a, ca);
-            b = SquarePlus(d, b, cb);
+            o.da = hn::Mul(o.da, hn::Mul(two, o.ra));
+            o.db = hn::Mul(o.db, hn::Mul(two, o.rb));
+            o.a = SquarePlus(d, o.a, ca);
+            o.b = SquarePlus(d, o.b, cb);
         } else if constexpr (Var == Variant::PaperCoupled) {
-            da = hn::Mul(da, hn::Mul(two, r8));
-            a = SquarePlus(d, a, ca);
-            b = SquarePlus(d, b, cb);
+            o.da = hn::Mul(o.da, hn::Mul(two, o.r8));
+            o.a = SquarePlus(d, o.a, ca);
+            o.b = SquarePlus(d, o.b, cb);
         } else {
-            da = hn::Mul(da, hn::Mul(two, ra));
-            const QuatV<V> previous = a;  // b must use the old a
-            a = SquarePlus(d, a, ca);
-            b = SymmetricPlus(d, previous, b, cb);
+            o.da = hn::Mul(o.da, hn::Mul(two, o.ra));
+            const QuatV<V> previous = o.a;  // b must use the old a
+            o.a = SquarePlus(d, o.a, ca);
+            o.b = SymmetricPlus(d, previous, o.b, cb);
         }
-        ra = Norm(a);
-        if constexpr (Var != Variant::Dual) rb = Norm(b);  // dual: only needed at exit
-        trap = StdMin(trap, ra);
+        o.ra = Norm(o.a);
+        if constexpr (Var != Variant::Dual) o.rb = Norm(o.b);  // dual: only needed at exit
+        o.trap = StdMin(o.trap, o.ra);
         hn::Mask<D> escapes;
         if constexpr (Var == Variant::Paper) {
-            escapes = hn::Or(hn::Gt(ra, bailout), hn::Gt(rb, bailout));
+            escapes = hn::Or(hn::Gt(o.ra, bailout), hn::Gt(o.rb, bailout));
         } else if constexpr (Var == Variant::PaperCoupled) {
-            r8 = hn::Sqrt(MulAddT(rb, rb, hn::Mul(ra, ra)));
-            escapes = hn::Gt(r8, bailout);
+            o.r8 = hn::Sqrt(MulAddT(o.rb, o.rb, hn::Mul(o.ra, o.ra)));
+            escapes = hn::Gt(o.r8, bailout);
         } else {
-            escapes = hn::Gt(ra, bailout);
+            escapes = hn::Gt(o.ra, bailout);
         }
         const auto now = hn::AndNot(escaped, escapes);  // escaping at this iteration
         // Branch-free: which lanes escape is data-dependent, so a branch here would mispredict.
-        nOut = hn::IfThenElse(now, hn::Set(d, static_cast<T>(k)), nOut);
-        raOut = hn::IfThenElse(now, ra, raOut);
+        frozen.n = hn::IfThenElse(now, hn::Set(d, static_cast<T>(k)), frozen.n);
+        frozen.ra = hn::IfThenElse(now, o.ra, frozen.ra);
         if constexpr (Var == Variant::Dual) {  // |b| is only needed at exit: keep b itself
-            bOut = {hn::IfThenElse(now, b.s, bOut.s), hn::IfThenElse(now, b.i, bOut.i),
-                    hn::IfThenElse(now, b.j, bOut.j), hn::IfThenElse(now, b.k, bOut.k)};
+            frozen.b = {hn::IfThenElse(now, o.b.s, frozen.b.s), hn::IfThenElse(now, o.b.i, frozen.b.i),
+                        hn::IfThenElse(now, o.b.j, frozen.b.j), hn::IfThenElse(now, o.b.k, frozen.b.k)};
         } else {
-            rbOut = hn::IfThenElse(now, rb, rbOut);
+            frozen.rb = hn::IfThenElse(now, o.rb, frozen.rb);
         }
-        r8Out = hn::IfThenElse(now, r8, r8Out);
-        daOut = hn::IfThenElse(now, da, daOut);
-        dbOut = hn::IfThenElse(now, db, dbOut);
-        trapOut = hn::IfThenElse(now, trap, trapOut);
+        if constexpr (Var == Variant::PaperCoupled) frozen.r8 = hn::IfThenElse(now, o.r8, frozen.r8);
+        frozen.da = hn::IfThenElse(now, o.da, frozen.da);
+        if constexpr (Var == Variant::Paper) frozen.db = hn::IfThenElse(now, o.db, frozen.db);
+        frozen.trap = hn::IfThenElse(now, o.trap, frozen.trap);
         escaped = hn::Or(escaped, now);
         if (hn::AllTrue(d, escaped)) break;
     }
-    if constexpr (Var == Variant::Dual) rbOut = Norm(bOut);
-    // Lanes that never escaped report the state after N iterations and DE 0.
-    if (!hn::AllTrue(d, escaped)) {
-        if constexpr (Var == Variant::Dual) rb = Norm(b);
-        raOut = hn::IfThenElse(escaped, raOut, ra);
-        rbOut = hn::IfThenElse(escaped, rbOut, rb);
-        r8Out = hn::IfThenElse(escaped, r8Out, r8);
-        trapOut = hn::IfThenElse(escaped, trapOut, trap);
+}
+
+/// Lanes that never escaped after N iterations: their outputs are the final state (DE 0).
+template <Variant Var, class D>
+HWY_INLINE void FreezeUnescaped(D /* tag */, hn::Mask<D> unescaped, const Orbit<hn::Vec<D>>& o,
+                                Frozen<hn::Vec<D>>& frozen) {
+    frozen.ra = hn::IfThenElse(unescaped, o.ra, frozen.ra);
+    frozen.rb = hn::IfThenElse(unescaped, Var == Variant::Dual ? Norm(o.b) : o.rb, frozen.rb);
+    frozen.r8 = hn::IfThenElse(unescaped, o.r8, frozen.r8);
+    frozen.trap = hn::IfThenElse(unescaped, o.trap, frozen.trap);
+}
+
+/// Orbits between segments: the carried fields of the live orbits, packed from index 0, and
+/// each orbit's point index within the chunk (exact in T: a chunk is at most kChunk points).
+template <typename T>
+struct OrbitStore {
+    enum Field { kA = 0, kB = 4, kRa = 8, kRb, kR8, kDa, kDb, kTrap, kIndex, kFields };
+    T* field[kFields];
+};
+
+/// Points a chunk of the batch holds: the store of its orbits stays in the core's cache.
+constexpr std::size_t kChunk = 4096;
+/// Iterations a segment runs before the orbits still running are packed together.
+constexpr int kSegment = 4;
+/// Orbits below which packing stops (the rest run to N): vectors' worth.
+constexpr std::size_t kPackMinimum = 2;
+
+/// This thread's OrbitStore for T (one buffer for every variant), each field `stride` long.
+template <typename T>
+OrbitStore<T> ThreadStore(std::size_t stride) {
+    thread_local std::vector<T> storage;
+    storage.resize(OrbitStore<T>::kFields * stride);
+    OrbitStore<T> store;
+    for (int f = 0; f < OrbitStore<T>::kFields; ++f) store.field[f] = storage.data() + f * stride;
+    return store;
+}
+
+template <Variant Var, class D, typename T = hn::TFromD<D>>
+HWY_INLINE Orbit<hn::Vec<D>> LoadOrbit(D d, const OrbitStore<T>& store, std::size_t at) {
+    using S = OrbitStore<T>;
+    T* const* f = store.field;
+    Orbit<hn::Vec<D>> o;
+    o.a = {hn::LoadU(d, f[S::kA] + at), hn::LoadU(d, f[S::kA + 1] + at), hn::LoadU(d, f[S::kA + 2] + at),
+           hn::LoadU(d, f[S::kA + 3] + at)};
+    o.b = {hn::LoadU(d, f[S::kB] + at), hn::LoadU(d, f[S::kB + 1] + at), hn::LoadU(d, f[S::kB + 2] + at),
+           hn::LoadU(d, f[S::kB + 3] + at)};
+    const auto zero = hn::Zero(d);
+    o.ra = Carried<Var>::ra ? hn::LoadU(d, f[S::kRa] + at) : zero;
+    o.rb = Carried<Var>::rb ? hn::LoadU(d, f[S::kRb] + at) : zero;
+    o.r8 = Carried<Var>::r8 ? hn::LoadU(d, f[S::kR8] + at) : zero;
+    o.db = Carried<Var>::db ? hn::LoadU(d, f[S::kDb] + at) : zero;
+    o.da = hn::LoadU(d, f[S::kDa] + at);
+    o.trap = hn::LoadU(d, f[S::kTrap] + at);
+    return o;
+}
+
+/// CompressStore through a register and a full store (the store has a vector's room past the
+/// packed lanes): the memory form of vcompressps/pd is slow on AMD Zen 4 (it made the packing
+/// kernel 2-3 times slower than none), and Highway 1.0.3's Compress of 64-bit lanes on AVX-512
+/// goes through a lookup table instead of vcompresspd.
+template <class D, typename T = hn::TFromD<D>>
+HWY_INLINE void PackStore(D d, hn::Vec<D> v, hn::Mask<D> mask, T* to) {
+#if HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL
+    if constexpr (sizeof(T) == 8 && hn::MaxLanes(d) == 8) {
+        hn::StoreU(hn::Vec<D>{_mm512_maskz_compress_pd(mask.raw, v.raw)}, d, to);
+    } else {
+        hn::StoreU(hn::Compress(v, mask), d, to);
     }
-    // The DE from the frozen values; non-escaped lanes get a harmless argument for the log.
+#else
+    hn::CompressStore(v, mask, d, to);
+#endif
+}
+
+/// Packs the `running` lanes' orbits and indices into the store from `to` on; returns how many.
+/// `to` is at most the index the vector was loaded from, so packing in place is safe.
+template <Variant Var, class D, typename T = hn::TFromD<D>>
+HWY_INLINE std::size_t KeepOrbits(D d, const Orbit<hn::Vec<D>>& o, hn::Vec<D> index, hn::Mask<D> running,
+                                  const OrbitStore<T>& store, std::size_t to) {
+    using S = OrbitStore<T>;
+    T* const* f = store.field;
+    const hn::Vec<D> parts[8] = {o.a.s, o.a.i, o.a.j, o.a.k, o.b.s, o.b.i, o.b.j, o.b.k};
+    for (int k = 0; k < 8; ++k) PackStore(d, parts[k], running, f[S::kA + k] + to);
+    if constexpr (Carried<Var>::ra) PackStore(d, o.ra, running, f[S::kRa] + to);
+    if constexpr (Carried<Var>::rb) PackStore(d, o.rb, running, f[S::kRb] + to);
+    if constexpr (Carried<Var>::r8) PackStore(d, o.r8, running, f[S::kR8] + to);
+    if constexpr (Carried<Var>::db) PackStore(d, o.db, running, f[S::kDb] + to);
+    PackStore(d, o.da, running, f[S::kDa] + to);
+    PackStore(d, o.trap, running, f[S::kTrap] + to);
+    PackStore(d, index, running, f[S::kIndex] + to);
+    return hn::CountTrue(d, running);
+}
+
+/// What a finished lane leaves in the result arrays until FinishEstimates: n, ra, rb and trap
+/// final; r holds the paper's db or paper-coupled's 8-D norm, de the derivative.
+template <Variant Var, class V>
+HWY_INLINE V PendingR(const Frozen<V>& f) {
+    return Var == Variant::Paper ? f.db : f.r8;
+}
+
+/// Every lane's outputs to entries at .. at + lanes - 1 (a full vector of the chunk's first
+/// segment; lanes still running are written again when they finish).
+template <Variant Var, class D, typename T = hn::TFromD<D>>
+HWY_INLINE void WriteAll(D d, const Frozen<hn::Vec<D>>& f, const EscapeBatch<T>& out, std::size_t at) {
+    if constexpr (sizeof(T) == 4) {
+        const hn::RebindToSigned<D> di;
+        hn::StoreU(hn::ConvertTo(di, f.n), di, out.n + at);
+    } else {
+        const hn::Rebind<std::int32_t, D> di;
+        hn::StoreU(hn::DemoteTo(di, f.n), di, out.n + at);
+    }
+    hn::StoreU(PendingR<Var>(f), d, out.r + at);
+    hn::StoreU(f.ra, d, out.ra + at);
+    hn::StoreU(f.rb, d, out.rb + at);
+    hn::StoreU(f.da, d, out.de + at);
+    hn::StoreU(f.trap, d, out.trap + at);
+}
+
+/// The `finished` lanes' outputs to the entries their indices name.
+template <Variant Var, class D, typename T = hn::TFromD<D>>
+HWY_INLINE void WriteFinished(D d, const Frozen<hn::Vec<D>>& f, hn::Mask<D> finished, hn::Vec<D> index,
+                              const EscapeBatch<T>& out) {
+    constexpr std::size_t kMaxLanes = HWY_MAX_BYTES / sizeof(T);
+    HWY_ALIGN T values[7][kMaxLanes];
+    const hn::Vec<D> fields[7] = {index, f.n, PendingR<Var>(f), f.ra, f.rb, f.da, f.trap};
+    for (int k = 0; k < 7; ++k) hn::Store(fields[k], d, values[k]);
+    static_assert(kMaxLanes <= 64, "a vector's mask bits fit 64 bits");
+    std::uint8_t bytes[8] = {};
+    hn::StoreMaskBits(d, finished, bytes);
+    std::uint64_t bits;
+    std::memcpy(&bits, bytes, sizeof(bits));
+    for (; bits != 0; bits &= bits - 1) {  // the finished lanes only: no branch a lane
+        const auto lane = static_cast<std::size_t>(std::countr_zero(bits));
+        const auto i = static_cast<std::size_t>(values[0][lane]);
+        out.n[i] = static_cast<std::int32_t>(values[1][lane]);
+        out.r[i] = values[2][lane];
+        out.ra[i] = values[3][lane];
+        out.rb[i] = values[4][lane];
+        out.de[i] = values[5][lane];
+        out.trap[i] = values[6][lane];
+    }
+}
+
+/// r and the DE of one vector from the pending results (n, r, ra, rb, de at index 0).
+template <Variant Var, class D, typename T = hn::TFromD<D>>
+HWY_INLINE void FinishVector(D d, const Constants<T>& constants, const std::int32_t* n, T* r, const T* ra, const T* rb,
+                             T* de) {
+    using V = hn::Vec<D>;
+    V count;
+    if constexpr (sizeof(T) == 4) {
+        count = hn::ConvertTo(d, hn::LoadU(hn::RebindToSigned<D>(), n));
+    } else {
+        count = hn::PromoteTo(d, hn::LoadU(hn::Rebind<std::int32_t, D>(), n));
+    }
+    const auto escaped = hn::Gt(count, hn::Zero(d));
+    const V bailout = hn::Set(d, constants.bailout);
     const V one = hn::Set(d, 1);
-    V r, de;
+    const V two = hn::Set(d, 2);
+    const V raOut = hn::LoadU(d, ra);
+    const V pending = hn::LoadU(d, r);
+    const V daOut = hn::LoadU(d, de);
+    // Non-escaped lanes get a harmless argument for the log.
+    V radius, estimate;
     if constexpr (Var == Variant::Paper) {
-        r = StdMax(raOut, rbOut);
+        const V rbOut = hn::LoadU(d, rb);
+        radius = StdMax(raOut, rbOut);
         // max, not min: min is 0 wherever one part never escapes and the marcher stalls.
         const auto aOut = hn::And(escaped, hn::Gt(raOut, bailout));
         const auto bOut = hn::And(escaped, hn::Gt(rbOut, bailout));
         const V deA = hn::IfThenElseZero(aOut, PartEstimate(d, hn::IfThenElse(aOut, raOut, two), daOut));
-        const V deB = hn::IfThenElseZero(bOut, PartEstimate(d, hn::IfThenElse(bOut, rbOut, two), dbOut));
-        de = StdMax(deA, deB);
-    } else if constexpr (Var == Variant::PaperCoupled) {
-        r = r8Out;
-        de = hn::IfThenElseZero(escaped, PartEstimate(d, hn::IfThenElse(escaped, r8Out, two),
-                                                      hn::IfThenElse(escaped, daOut, one)));
+        const V deB = hn::IfThenElseZero(bOut, PartEstimate(d, hn::IfThenElse(bOut, rbOut, two), pending));
+        estimate = StdMax(deA, deB);
     } else {
-        r = raOut;
-        de = hn::IfThenElseZero(escaped, PartEstimate(d, hn::IfThenElse(escaped, raOut, two),
-                                                      hn::IfThenElse(escaped, daOut, one)));
+        radius = Var == Variant::PaperCoupled ? pending : raOut;
+        estimate = hn::IfThenElseZero(escaped, PartEstimate(d, hn::IfThenElse(escaped, radius, two),
+                                                            hn::IfThenElse(escaped, daOut, one)));
     }
-    hn::StoreU(nOut, d, out[0]);
-    hn::StoreU(r, d, out[1]);
-    hn::StoreU(raOut, d, out[2]);
-    hn::StoreU(rbOut, d, out[3]);
-    hn::StoreU(de, d, out[4]);
-    hn::StoreU(trapOut, d, out[5]);
+    hn::StoreU(radius, d, r);
+    hn::StoreU(estimate, d, de);
 }
 
-/// Runs every full vector in place and the tail through zero-padded local arrays.
+/// r and the DE of every point of a chunk, once all have finished.
+template <Variant Var, class D, typename T = hn::TFromD<D>>
+HWY_INLINE void FinishEstimates(D d, const Constants<T>& constants, const EscapeBatch<T>& out, std::size_t count) {
+    const std::size_t lanes = hn::Lanes(d);
+    std::size_t at = 0;
+    for (; at + lanes <= count; at += lanes)
+        FinishVector<Var>(d, constants, out.n + at, out.r + at, out.ra + at, out.rb + at, out.de + at);
+    if (at == count) return;
+    constexpr std::size_t kMaxLanes = HWY_MAX_BYTES / sizeof(T);
+    const std::size_t rest = count - at;
+    std::int32_t n[kMaxLanes] = {};
+    HWY_ALIGN T r[kMaxLanes] = {}, ra[kMaxLanes] = {}, rb[kMaxLanes] = {}, de[kMaxLanes] = {};
+    std::memcpy(n, out.n + at, rest * sizeof(std::int32_t));
+    std::memcpy(r, out.r + at, rest * sizeof(T));
+    std::memcpy(ra, out.ra + at, rest * sizeof(T));
+    std::memcpy(rb, out.rb + at, rest * sizeof(T));
+    std::memcpy(de, out.de + at, rest * sizeof(T));
+    FinishVector<Var>(d, constants, n, r, ra, rb, de);
+    std::memcpy(out.r + at, r, rest * sizeof(T));
+    std::memcpy(out.de + at, de, rest * sizeof(T));
+}
+
+/// One chunk of at most kChunk points. Every vector runs a segment of kSegment iterations
+/// from its start points; the orbits still running then are packed into the store, whose
+/// vectors run the next segment, and so on until N, so lanes do not idle behind a vector's
+/// slowest point for more than a segment. A vector whose lanes are mostly still running goes on
+/// to N instead, and below kPackMinimum vectors' worth of orbits (or with fewer than 4 lanes)
+/// the rest run to N in one segment. Each point's operations are those of evaluate(), in its
+/// order, so packing changes no result.
+template <Variant Var, class D, typename T = hn::TFromD<D>>
+HWY_INLINE void IterateChunk(D d, const Constants<T>& constants, const T* const* in, const EscapeBatch<T>& out,
+                             std::size_t count, const OrbitStore<T>& store) {
+    using V = hn::Vec<D>;
+    const std::size_t lanes = hn::Lanes(d);
+    const int iterations = constants.iterations;
+    auto segmentEnd = [&](int from, std::size_t orbits) {
+        return orbits > kPackMinimum * lanes && lanes >= 4 ? std::min(iterations, from + kSegment) : iterations;
+    };
+    // Runs one vector to `to`, or on to N if most of its lanes are still running then (packing
+    // them would cost more than their idle neighbours); returns the orbits packed. Inlined: as a
+    // call, the orbit went through memory and the kernel was slower than without packing.
+    auto run = [&](Orbit<V> & o, V index, std::size_t live, int from, int to, std::size_t kept, bool direct,
+                   std::size_t at) __attribute__((always_inline)) {
+        const auto liveLanes = hn::FirstN(d, live);
+        auto escaped = hn::Not(liveLanes);
+        const V zero = hn::Zero(d);
+        Frozen<V> frozen{zero, zero, zero, zero, zero, zero, zero, {zero, zero, zero, zero}};
+        Iterate<Var>(d, constants, o, from, to, escaped, frozen);
+        if (to < iterations && 2 * hn::CountTrue(d, hn::Not(escaped)) > lanes) {
+            Iterate<Var>(d, constants, o, to, iterations, escaped, frozen);
+            to = iterations;
+        }
+        if constexpr (Var == Variant::Dual) frozen.rb = Norm(frozen.b);
+        auto running = hn::AndNot(escaped, liveLanes);
+        auto finished = hn::And(escaped, liveLanes);
+        if (to == iterations) {
+            FreezeUnescaped<Var>(d, running, o, frozen);
+            finished = liveLanes;
+            running = hn::AndNot(liveLanes, liveLanes);
+        }
+        if (direct) {
+            WriteAll<Var>(d, frozen, out, at);
+        } else {
+            WriteFinished<Var>(d, frozen, finished, index, out);
+        }
+        return hn::AllFalse(d, running) ? std::size_t{0} : KeepOrbits<Var>(d, o, index, running, store, kept);
+    };
+
+    int to = segmentEnd(0, count);
+    std::size_t kept = 0;
+    for (std::size_t at = 0; at < count; at += lanes) {
+        const V index = hn::Iota(d, static_cast<T>(at));
+        if (at + lanes <= count) {
+            Orbit<V> o = StartOrbit<Var>(d, in, at);
+            kept += run(o, index, lanes, 0, to, kept, true, at);
+        } else {  // the tail, through zero-padded copies
+            constexpr std::size_t kMaxLanes = HWY_MAX_BYTES / sizeof(T);
+            HWY_ALIGN T padded[8][kMaxLanes] = {};
+            const T* start[8];
+            for (int k = 0; k < 8; ++k) {
+                std::memcpy(padded[k], in[k] + at, (count - at) * sizeof(T));
+                start[k] = padded[k];
+            }
+            Orbit<V> o = StartOrbit<Var>(d, start, 0);
+            kept += run(o, index, count - at, 0, to, kept, false, at);
+        }
+    }
+    for (int from = to; kept > 0; from = to) {
+        const std::size_t orbits = kept;
+        to = segmentEnd(from, orbits);
+        kept = 0;
+        for (std::size_t at = 0; at < orbits; at += lanes) {
+            Orbit<V> o = LoadOrbit<Var>(d, store, at);
+            const V index = hn::LoadU(d, store.field[OrbitStore<T>::kIndex] + at);
+            kept += run(o, index, std::min(lanes, orbits - at), from, to, kept, false, at);
+        }
+    }
+    FinishEstimates<Var>(d, constants, out, count);
+}
+
 template <Variant Var, typename T>
 void IterateAll(const Constants<T>& constants, const PointBatch<T>& points, const EscapeBatch<T>& results) {
     const hn::ScalableTag<T> d;
-    const std::size_t lanes = hn::Lanes(d);
-    constexpr std::size_t kMaxLanes = HWY_MAX_BYTES / sizeof(T);
-    // Per vector: the results in T (escape count included), converted to the caller's arrays.
-    HWY_ALIGN T buffer[6][kMaxLanes] = {};
-    T* out[6] = {buffer[0], buffer[1], buffer[2], buffer[3], buffer[4], buffer[5]};
-    const T* in[8];
-    HWY_ALIGN T padded[8][kMaxLanes];
-
-    std::size_t first = 0;
-    for (; first + lanes <= points.count; first += lanes) {
-        // Full vectors: the T results go straight to the caller's arrays, n through the buffer.
-        for (int k = 0; k < 8; ++k) in[k] = points.coords[k] + first;
-        T* direct[6] = {buffer[0],          results.r + first,  results.ra + first,
-                        results.rb + first, results.de + first, results.trap + first};
-        IterateVector<Var>(d, constants, in, direct);
-        for (std::size_t lane = 0; lane < lanes; ++lane)
-            results.n[first + lane] = static_cast<std::int32_t>(buffer[0][lane]);
-    }
-    if (first < points.count) {
-        const std::size_t rest = points.count - first;
-        for (int k = 0; k < 8; ++k) {
-            std::memset(padded[k], 0, sizeof(padded[k]));
-            std::memcpy(padded[k], points.coords[k] + first, rest * sizeof(T));
-            in[k] = padded[k];
-        }
-        IterateVector<Var>(d, constants, in, out);
-        for (std::size_t lane = 0; lane < rest; ++lane) {
-            results.n[first + lane] = static_cast<std::int32_t>(buffer[0][lane]);
-            results.r[first + lane] = buffer[1][lane];
-            results.ra[first + lane] = buffer[2][lane];
-            results.rb[first + lane] = buffer[3][lane];
-            results.de[first + lane] = buffer[4][lane];
-            results.trap[first + lane] = buffer[5][lane];
-        }
+    const OrbitStore<T> store = ThreadStore<T>(kChunk + hn::Lanes(d));
+    for (std::size_t base = 0; base < points.count; base += kChunk) {
+        const T* in[8];
+        for (int k = 0; k < 8; ++k) in[k] = points.coords[k] + base;
+        const EscapeBatch<T> out{results.n + base,  results.r + base,  results.ra + base,
+                                 results.rb + base, results.de + base, results.trap + base};
+        IterateChunk<Var>(d, constants, in, out, std::min(kChunk, points.count - base), store);
     }
 }
 

@@ -20,7 +20,9 @@
 // The exit state (Escape::exit) is not computed.
 //
 // Cost: as evaluate() per point, divided by the lanes per vector (8 doubles or 16 floats with
-// AVX-512), plus lanes that idle while the slowest point of their vector is still iterating.
+// AVX-512), plus lanes that idle while the slowest point of their vector is still iterating
+// (the orbits still running are packed together every few iterations, so at most a few
+// iterations a point) and the packing itself.
 #pragma once
 
 #include <array>

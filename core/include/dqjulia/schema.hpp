@@ -57,8 +57,8 @@ struct Field {
     double min = 0.0, max = 0.0;  ///< the file's range: values (each component of vectors) or item counts
     bool minExclusive = false, maxExclusive = false;
     double softMin = 0.0, softMax = 0.0;  ///< the range a slider offers; min and max when equal
-    std::span<const Choice>
-        choices;  ///< Choice, ChoiceSet (the index is the C++ enum's value); Animation: interpolations
+    std::span<const Choice> choices =
+        {};  ///< Choice, ChoiceSet (the index is the C++ enum's value); Animation: interpolations
     std::uint32_t flags = 0;
 
     bool has(Flags flag) const { return (flags & flag) != 0; }
