@@ -26,7 +26,6 @@
 #include <limits>
 #include <stdexcept>
 #include <type_traits>
-#include <vector>
 
 #include "dqjulia/batch.hpp"
 
@@ -230,21 +229,19 @@ struct OrbitStore {
     T* field[kFields];
 };
 
-/// Points a chunk of the batch holds: the store of its orbits stays in the core's cache.
-constexpr std::size_t kChunk = 4096;
+/// Points a chunk of the batch holds. Its store (about 36 KB in double) lives on the stack: a
+/// thread_local buffer would be freed too early by MinGW's emulated TLS (thread_scratch.hpp).
+constexpr std::size_t kChunk = 256;
 /// Iterations a segment runs before the orbits still running are packed together.
 constexpr int kSegment = 4;
 /// Orbits below which packing stops (the rest run to N): vectors' worth.
 constexpr std::size_t kPackMinimum = 2;
 
-/// This thread's OrbitStore for T (one buffer for every variant), each field `stride` long.
-template <typename T>
-OrbitStore<T> ThreadStore(std::size_t stride) {
-    thread_local std::vector<T> storage;
-    storage.resize(OrbitStore<T>::kFields * stride);
-    OrbitStore<T> store;
-    for (int f = 0; f < OrbitStore<T>::kFields; ++f) store.field[f] = storage.data() + f * stride;
-    return store;
+/// Zeroes the vector after the `kept` packed orbits, so that the lanes past them in the last
+/// vector the next segment loads are defined (they hold no orbit and count as escaped).
+template <class D, typename T = hn::TFromD<D>>
+HWY_INLINE void ClearAfter(D d, const OrbitStore<T>& store, std::size_t kept) {
+    for (T* field : store.field) hn::StoreU(hn::Zero(d), d, field + kept);
 }
 
 template <Variant Var, class D, typename T = hn::TFromD<D>>
@@ -478,6 +475,7 @@ HWY_INLINE void IterateChunk(D d, const Constants<T>& constants, const T* const*
         }
     }
     for (int from = to; kept > 0; from = to) {
+        ClearAfter(d, store, kept);
         const std::size_t orbits = kept;
         to = segmentEnd(from, orbits);
         kept = 0;
@@ -493,7 +491,10 @@ HWY_INLINE void IterateChunk(D d, const Constants<T>& constants, const T* const*
 template <Variant Var, typename T>
 void IterateAll(const Constants<T>& constants, const PointBatch<T>& points, const EscapeBatch<T>& results) {
     const hn::ScalableTag<T> d;
-    const OrbitStore<T> store = ThreadStore<T>(kChunk + hn::Lanes(d));
+    constexpr std::size_t kMaxLanes = HWY_MAX_BYTES / sizeof(T);
+    HWY_ALIGN T storage[OrbitStore<T>::kFields][kChunk + kMaxLanes];  // a vector's room past the packed orbits
+    OrbitStore<T> store;
+    for (int f = 0; f < OrbitStore<T>::kFields; ++f) store.field[f] = storage[f];
     for (std::size_t base = 0; base < points.count; base += kChunk) {
         const T* in[8];
         for (int k = 0; k < 8; ++k) in[k] = points.coords[k] + base;
