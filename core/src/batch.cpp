@@ -230,7 +230,7 @@ struct OrbitStore {
 };
 
 /// Points a chunk of the batch holds. Its store (about 36 KB in double) lives on the stack: a
-/// thread_local buffer would be freed too early by MinGW's emulated TLS (thread_scratch.hpp).
+/// buffer kept per thread would be freed too early by MinGW's emulated TLS (thread_scratch.hpp).
 constexpr std::size_t kChunk = 256;
 /// Iterations a segment runs before the orbits still running are packed together.
 constexpr int kSegment = 4;
