@@ -43,6 +43,10 @@ struct Constants {
     int iterations;
 };
 
+/// Lanes of the widest vector of T on any target: the size of per-vector local arrays.
+template <typename T>
+constexpr std::size_t kMaxLanes = HWY_MAX_BYTES / sizeof(T);
+
 template <class V>
 struct QuatV {
     V s, i, j, k;
@@ -328,11 +332,10 @@ HWY_INLINE void WriteAll(D d, const Frozen<hn::Vec<D>>& f, const EscapeBatch<T>&
 template <Variant Var, class D, typename T = hn::TFromD<D>>
 HWY_INLINE void WriteFinished(D d, const Frozen<hn::Vec<D>>& f, hn::Mask<D> finished, hn::Vec<D> index,
                               const EscapeBatch<T>& out) {
-    constexpr std::size_t kMaxLanes = HWY_MAX_BYTES / sizeof(T);
-    HWY_ALIGN T values[7][kMaxLanes];
+    HWY_ALIGN T values[7][kMaxLanes<T>];
     const hn::Vec<D> fields[7] = {index, f.n, PendingR<Var>(f), f.ra, f.rb, f.da, f.trap};
     for (int k = 0; k < 7; ++k) hn::Store(fields[k], d, values[k]);
-    static_assert(kMaxLanes <= 64, "a vector's mask bits fit 64 bits");
+    static_assert(kMaxLanes<T> <= 64, "a vector's mask bits fit 64 bits");
     std::uint8_t bytes[8] = {};
     hn::StoreMaskBits(d, finished, bytes);
     std::uint64_t bits;
@@ -395,10 +398,9 @@ HWY_INLINE void FinishEstimates(D d, const Constants<T>& constants, const Escape
     for (; at + lanes <= count; at += lanes)
         FinishVector<Var>(d, constants, out.n + at, out.r + at, out.ra + at, out.rb + at, out.de + at);
     if (at == count) return;
-    constexpr std::size_t kMaxLanes = HWY_MAX_BYTES / sizeof(T);
     const std::size_t rest = count - at;
-    std::int32_t n[kMaxLanes] = {};
-    HWY_ALIGN T r[kMaxLanes] = {}, ra[kMaxLanes] = {}, rb[kMaxLanes] = {}, de[kMaxLanes] = {};
+    std::int32_t n[kMaxLanes<T>] = {};
+    HWY_ALIGN T r[kMaxLanes<T>] = {}, ra[kMaxLanes<T>] = {}, rb[kMaxLanes<T>] = {}, de[kMaxLanes<T>] = {};
     std::memcpy(n, out.n + at, rest * sizeof(std::int32_t));
     std::memcpy(r, out.r + at, rest * sizeof(T));
     std::memcpy(ra, out.ra + at, rest * sizeof(T));
@@ -463,8 +465,7 @@ HWY_INLINE void IterateChunk(D d, const Constants<T>& constants, const T* const*
             Orbit<V> o = StartOrbit<Var>(d, in, at);
             kept += run(o, index, lanes, 0, to, kept, true, at);
         } else {  // the tail, through zero-padded copies
-            constexpr std::size_t kMaxLanes = HWY_MAX_BYTES / sizeof(T);
-            HWY_ALIGN T padded[8][kMaxLanes] = {};
+            HWY_ALIGN T padded[8][kMaxLanes<T>] = {};
             const T* start[8];
             for (int k = 0; k < 8; ++k) {
                 std::memcpy(padded[k], in[k] + at, (count - at) * sizeof(T));
@@ -491,8 +492,7 @@ HWY_INLINE void IterateChunk(D d, const Constants<T>& constants, const T* const*
 template <Variant Var, typename T>
 void IterateAll(const Constants<T>& constants, const PointBatch<T>& points, const EscapeBatch<T>& results) {
     const hn::ScalableTag<T> d;
-    constexpr std::size_t kMaxLanes = HWY_MAX_BYTES / sizeof(T);
-    HWY_ALIGN T storage[OrbitStore<T>::kFields][kChunk + kMaxLanes];  // a vector's room past the packed orbits
+    HWY_ALIGN T storage[OrbitStore<T>::kFields][kChunk + kMaxLanes<T>];  // a vector's room past the packed orbits
     OrbitStore<T> store;
     for (int f = 0; f < OrbitStore<T>::kFields; ++f) store.field[f] = storage[f];
     for (std::size_t base = 0; base < points.count; base += kChunk) {
