@@ -7,19 +7,26 @@
 // the default constant c = (-0.39054, -0.58679, 0, 0)(0, 0.5632, 0, 0.05), N = 12, R = 4: what
 // the renderer and the bake ask for (about a quarter of the points are inside).
 //
-// Flops: counted per iteration from the kernel's operations (multiplies, adds, square roots;
-// a fused multiply-add counts 2, a comparison 0): paper 51, paper-coupled 53, dual 50 (see
-// kFlopsPerIteration), times the iterations each point needs (its escape count, or N). The
-// final DE (a logarithm and a division per point) is not counted. Lanes that idle while their
-// vector's slowest point iterates do no useful work and are not counted either.
+// Flops: counted per iteration from batch.cpp's Iterate (a multiply, an add and a min count 1,
+// a multiply-add 2 whether fused (float) or not (double), a comparison or a blend 0): a
+// quaternion square plus c is 15, the symmetric product plus c 24, a squared norm 7, a
+// derivative update 2, so paper 49 (2 squares, 2 norms, 2 updates, the min), paper-coupled 48
+// (2 squares, 2 norms, 1 update, the 8-D sum, the min) and dual 49 (a square, a symmetric
+// product, 1 norm, 1 update, the min) (kFlopsPerIteration; bench/README.md's table), times the
+// iterations each point needs (its escape count, or N). The work once a point (its square
+// roots, a logarithm and a division) is not counted; nor are lanes that idle while their
+// vector's slowest point iterates.
 //
-// Peak: lanes of the detected instruction set x 2 FMA units x 2 flops x clock (the first
-// "cpu MHz" of /proc/cpuinfo), for one core. CPUs that execute 512-bit FMAs as two 256-bit
-// halves (AMD Zen 4) have half that peak for AVX-512; the summary says which it assumed.
+// Peak: fused multiply-adds a second measured on this core (measuredFmaRate: independent FMAs
+// of the dispatched width, so the clock it runs at, turbo included, and the FMA units it has
+// are both in the figure) x lanes x 2 flops. Where that cannot be measured (not x86-64),
+// lanes x 2 FMA units x 2 flops x the first "cpu MHz" of /proc/cpuinfo.
 //
 // Run: build-bench/bin/dqjulia_bench (bench/run.sh builds it)  (Google Benchmark flags work, e.g. --benchmark_filter=dual)
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -27,6 +34,10 @@
 #include <random>
 #include <string>
 #include <vector>
+
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
 
 #include "dqjulia/batch.hpp"
 #include "dqjulia/estimate.hpp"
@@ -38,7 +49,7 @@ using namespace dqj;
 namespace {
 
 constexpr Variant kVariants[] = {Variant::Paper, Variant::PaperCoupled, Variant::Dual};
-constexpr double kFlopsPerIteration[] = {51.0, 53.0, 50.0};  // paper, paper-coupled, dual
+constexpr double kFlopsPerIteration[] = {49.0, 48.0, 49.0};  // paper, paper-coupled, dual
 constexpr std::size_t kPoints = 16384;
 
 Fractal benchFractal(Variant variant) {
@@ -170,14 +181,61 @@ double clockGHz() {
     return 0.0;
 }
 
-bool splitsWideFma() {  // AMD family 25 (Zen 4) runs a 512-bit FMA as two 256-bit halves
-    std::ifstream cpuinfo("/proc/cpuinfo");
-    bool amd = false;
-    for (std::string line; std::getline(cpuinfo, line);) {
-        if (line.rfind("vendor_id", 0) == 0) amd = line.find("AuthenticAMD") != std::string::npos;
-        if (line.rfind("cpu family", 0) == 0) return amd && line.find(": 25") != std::string::npos;
+constexpr int kFmaChains = 16;  // independent: two FMA units of latency 4 need 8 in flight
+
+#if defined(__x86_64__)
+/// `rounds` x kFmaChains independent FMAs on 512-bit vectors; returns their sum.
+__attribute__((target("avx512f"))) double fmaChains512(long rounds) {
+    __m512d acc[kFmaChains];
+    for (int k = 0; k < kFmaChains; ++k) acc[k] = _mm512_set1_pd(1.0 + k);
+    const __m512d scale = _mm512_set1_pd(0.999999), shift = _mm512_set1_pd(1e-6);
+    for (long round = 0; round < rounds; ++round)
+        for (__m512d& a : acc) a = _mm512_fmadd_pd(a, scale, shift);
+    double sum = 0.0;
+    for (const __m512d& a : acc) sum += _mm512_reduce_add_pd(a);
+    return sum;
+}
+
+/// The same on 256-bit vectors (AVX2 and FMA).
+__attribute__((target("avx2,fma"))) double fmaChains256(long rounds) {
+    __m256d acc[kFmaChains];
+    for (int k = 0; k < kFmaChains; ++k) acc[k] = _mm256_set1_pd(1.0 + k);
+    const __m256d scale = _mm256_set1_pd(0.999999), shift = _mm256_set1_pd(1e-6);
+    for (long round = 0; round < rounds; ++round)
+        for (__m256d& a : acc) a = _mm256_fmadd_pd(a, scale, shift);
+    double lanes[4], sum = 0.0;
+    for (const __m256d& a : acc) {
+        _mm256_storeu_pd(lanes, a);
+        sum += lanes[0] + lanes[1] + lanes[2] + lanes[3];
     }
-    return false;
+    return sum;
+}
+
+/// FMAs a second through `chains`: the best of 5 runs of about 50 ms.
+double fmaRateOf(double (*chains)(long)) {
+    using Clock = std::chrono::steady_clock;
+    constexpr long kRounds = 20'000'000;
+    double best = 0.0;
+    for (int run = 0; run < 5; ++run) {
+        const auto start = Clock::now();
+        benchmark::DoNotOptimize(chains(kRounds));
+        const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
+        best = std::max(best, kFmaChains * static_cast<double>(kRounds) / seconds);
+    }
+    return best;
+}
+#endif
+
+/// FMA instructions a second one core sustains at the dispatched width (`doubleLanes` doubles
+/// a vector); 0 where it is not measured (not x86-64, or a width without FMA: SSE).
+double measuredFmaRate(std::size_t doubleLanes) {
+#if defined(__x86_64__)
+    if (doubleLanes == 8) return fmaRateOf(fmaChains512);
+    if (doubleLanes == 4) return fmaRateOf(fmaChains256);
+#else
+    (void)doubleLanes;
+#endif
+    return 0.0;
 }
 
 std::string name(const char* kind, Variant variant, const std::string& target = "") {
@@ -212,25 +270,27 @@ int main(int argc, char** argv) {
     benchmark::Shutdown();
 
     const double ghz = clockGHz();
-    const bool split = splitsWideFma();
     const double doubleLanes = static_cast<double>(batchLanes(false));
     const double floatLanes = static_cast<double>(batchLanes(true));
-    // Lanes of the FMA units: the detected vector width, halved when 512-bit FMAs are split.
-    const double fmaDoubleLanes = split && doubleLanes > 4 ? doubleLanes / 2 : doubleLanes;
-    const double fmaFloatLanes = split && floatLanes > 8 ? floatLanes / 2 : floatLanes;
-    const double peakDouble = fmaDoubleLanes * 2.0 * 2.0 * ghz * 1e9;
-    const double peakFloat = fmaFloatLanes * 2.0 * 2.0 * ghz * 1e9;
+    const double fmaRate = measuredFmaRate(batchLanes(false));
+    // A float FMA of the same width has the throughput of a double one on every x86 core.
+    const double fmasPerSecond = fmaRate > 0.0 ? fmaRate : 2.0 * ghz * 1e9;
+    const double peakDouble = doubleLanes * 2.0 * fmasPerSecond;
+    const double peakFloat = floatLanes * 2.0 * fmasPerSecond;
     std::printf("\nSummary (same run, one thread; %s dispatched, %s fallback)\n", best.name.c_str(),
                 fallback.name.c_str());
-    std::printf(
-        "peak of one core: %.0f lanes (double) / %.0f (float) per FMA x 2 FMA units x 2 flops x %.3f GHz = "
-        "%.1f GFLOP/s double, %.1f float%s\n",
-        fmaDoubleLanes, fmaFloatLanes, ghz, peakDouble / 1e9, peakFloat / 1e9,
-        split ? " (512-bit FMAs counted as two 256-bit halves: AMD Zen 4)" : "");
-    if (split)
+    if (fmaRate > 0.0) {
         std::printf(
-            "(at the full detected width, %.0f doubles / %.0f floats, the nominal peak would be %.1f / %.1f GFLOP/s)\n",
-            doubleLanes, floatLanes, doubleLanes * 4.0 * ghz, floatLanes * 4.0 * ghz);
+            "peak of one core, measured: %.2f G FMA/s of %.0f doubles (%.2f a cycle at cpuinfo's %.3f GHz) x 2 flops = "
+            "%.1f GFLOP/s double, %.1f float (%.0f lanes)\n",
+            fmaRate / 1e9, doubleLanes, ghz > 0.0 ? fmaRate / (ghz * 1e9) : 0.0, ghz, peakDouble / 1e9, peakFloat / 1e9,
+            floatLanes);
+    } else {
+        std::printf(
+            "peak of one core, nominal: %.0f lanes (double) / %.0f (float) x 2 FMA units x 2 flops x %.3f GHz "
+            "(cpuinfo) = %.1f GFLOP/s double, %.1f float\n",
+            doubleLanes, floatLanes, ghz, peakDouble / 1e9, peakFloat / 1e9);
+    }
     std::printf("%-14s %14s %14s %8s %14s %8s %14s %9s %9s %9s\n", "variant", "scalar Meval/s", "double Meval/s",
                 "x scalar", "float Meval/s", "x scalar", "fallback dbl", "scal %pk", "dbl %pk", "flt %pk");
     for (const Variant variant : kVariants) {

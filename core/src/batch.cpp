@@ -39,7 +39,7 @@ template <typename T>
 struct Constants {
     T ca[4];
     T cb[4];
-    T bailout;
+    T escapeAbove;  // squaredBailout(R): a squared norm above it has escaped
     int iterations;
 };
 
@@ -82,10 +82,10 @@ HWY_INLINE V StdMax(V a, V b) {
     return hn::IfThenElse(hn::Lt(a, b), b, a);
 }
 
-/// |q| = sqrt(((s^2 + i^2) + j^2) + k^2), dot4's order.
+/// |q|^2 = ((s^2 + i^2) + j^2) + k^2, dot4's order.
 template <class V>
-HWY_INLINE V Norm(const QuatV<V>& q) {
-    return hn::Sqrt(MulAddT(q.k, q.k, MulAddT(q.j, q.j, MulAddT(q.i, q.i, hn::Mul(q.s, q.s)))));
+HWY_INLINE V SquaredNorm(const QuatV<V>& q) {
+    return MulAddT(q.k, q.k, MulAddT(q.j, q.j, MulAddT(q.i, q.i, hn::Mul(q.s, q.s))));
 }
 
 /// square(q) + c: (s^2 - i^2 - j^2 - k^2, 2 s i, 2 s j, 2 s k) + c.
@@ -114,26 +114,27 @@ HWY_INLINE V PartEstimate(D d, V norm, V derivative) {
                           estimate);
 }
 
-/// One vector of orbits between iterations. Which fields carry over from one iteration to the
-/// next depends on the variant (Carried); the others are recomputed every iteration.
+/// One vector of orbits between iterations, norms and derivatives squared as in estimate.cpp.
+/// Which fields carry over from one iteration to the next depends on the variant (Carried);
+/// the others are recomputed every iteration.
 template <class V>
 struct Orbit {
     QuatV<V> a, b;
-    V ra, rb, r8, da, db, trap;
+    V sa, sb, s8, da, db, trap;
 };
 
 template <Variant Var>
 struct Carried {
-    static constexpr bool ra = Var != Variant::PaperCoupled;  // da's factor (paper, dual)
-    static constexpr bool rb = Var == Variant::Paper;         // db's factor
-    static constexpr bool r8 = Var == Variant::PaperCoupled;  // the 8-D dr's factor
+    static constexpr bool sa = Var != Variant::PaperCoupled;  // da's factor (paper, dual)
+    static constexpr bool sb = Var == Variant::Paper;         // db's factor
+    static constexpr bool s8 = Var == Variant::PaperCoupled;  // the 8-D dr's factor
     static constexpr bool db = Var == Variant::Paper;
 };
 
-/// The outputs of a vector's lanes, frozen at the iteration each escaped.
+/// The outputs of a vector's lanes, frozen at the iteration each escaped (squared).
 template <class V>
 struct Frozen {
-    V n, ra, rb, r8, da, db, trap;
+    V n, sa, sb, s8, da, db, trap;
     QuatV<V> b;  // dual: b at escape (its norm is taken once, at the end)
 };
 
@@ -143,13 +144,12 @@ HWY_INLINE Orbit<hn::Vec<D>> StartOrbit(D d, const T* const* in, std::size_t at)
     Orbit<V> o;
     o.a = {hn::LoadU(d, in[0] + at), hn::LoadU(d, in[1] + at), hn::LoadU(d, in[2] + at), hn::LoadU(d, in[3] + at)};
     o.b = {hn::LoadU(d, in[4] + at), hn::LoadU(d, in[5] + at), hn::LoadU(d, in[6] + at), hn::LoadU(d, in[7] + at)};
-    o.ra = Norm(o.a);
-    o.rb = Norm(o.b);
-    // paper-coupled: the 8-D norm sqrt(ra^2 + rb^2), from the rounded ra and rb as estimate.cpp.
-    o.r8 = Var == Variant::PaperCoupled ? hn::Sqrt(MulAddT(o.rb, o.rb, hn::Mul(o.ra, o.ra))) : hn::Zero(d);
-    o.da = hn::Set(d, 1);  // paper, dual: |da|; paper-coupled: the 8-D dr
+    o.sa = SquaredNorm(o.a);
+    o.sb = SquaredNorm(o.b);
+    o.s8 = Var == Variant::PaperCoupled ? hn::Add(o.sa, o.sb) : hn::Zero(d);  // the 8-D norm squared
+    o.da = hn::Set(d, 1);  // paper, dual: |da|^2; paper-coupled: the 8-D dr^2
     o.db = hn::Set(d, 1);
-    o.trap = o.ra;
+    o.trap = o.sa;
     return o;
 }
 
@@ -166,47 +166,47 @@ HWY_INLINE void Iterate(D d, const Constants<T>& constants, Orbit<hn::Vec<D>>& o
         ca[k] = hn::Set(d, constants.ca[k]);
         cb[k] = hn::Set(d, constants.cb[k]);
     }
-    const V bailout = hn::Set(d, constants.bailout);
-    const V two = hn::Set(d, 2);
+    const V escapeAbove = hn::Set(d, constants.escapeAbove);
+    const V four = hn::Set(d, 4);
     for (int k = from + 1; k <= to; ++k) {
         if constexpr (Var == Variant::Paper) {
-            o.da = hn::Mul(o.da, hn::Mul(two, o.ra));
-            o.db = hn::Mul(o.db, hn::Mul(two, o.rb));
+            o.da = hn::Mul(o.da, hn::Mul(four, o.sa));
+            o.db = hn::Mul(o.db, hn::Mul(four, o.sb));
             o.a = SquarePlus(d, o.a, ca);
             o.b = SquarePlus(d, o.b, cb);
         } else if constexpr (Var == Variant::PaperCoupled) {
-            o.da = hn::Mul(o.da, hn::Mul(two, o.r8));
+            o.da = hn::Mul(o.da, hn::Mul(four, o.s8));
             o.a = SquarePlus(d, o.a, ca);
             o.b = SquarePlus(d, o.b, cb);
         } else {
-            o.da = hn::Mul(o.da, hn::Mul(two, o.ra));
+            o.da = hn::Mul(o.da, hn::Mul(four, o.sa));
             const QuatV<V> previous = o.a;  // b must use the old a
             o.a = SquarePlus(d, o.a, ca);
             o.b = SymmetricPlus(d, previous, o.b, cb);
         }
-        o.ra = Norm(o.a);
-        if constexpr (Var != Variant::Dual) o.rb = Norm(o.b);  // dual: only needed at exit
-        o.trap = StdMin(o.trap, o.ra);
+        o.sa = SquaredNorm(o.a);
+        if constexpr (Var != Variant::Dual) o.sb = SquaredNorm(o.b);  // dual: only needed at exit
+        o.trap = StdMin(o.trap, o.sa);
         hn::Mask<D> escapes;
         if constexpr (Var == Variant::Paper) {
-            escapes = hn::Or(hn::Gt(o.ra, bailout), hn::Gt(o.rb, bailout));
+            escapes = hn::Or(hn::Gt(o.sa, escapeAbove), hn::Gt(o.sb, escapeAbove));
         } else if constexpr (Var == Variant::PaperCoupled) {
-            o.r8 = hn::Sqrt(MulAddT(o.rb, o.rb, hn::Mul(o.ra, o.ra)));
-            escapes = hn::Gt(o.r8, bailout);
+            o.s8 = hn::Add(o.sa, o.sb);
+            escapes = hn::Gt(o.s8, escapeAbove);
         } else {
-            escapes = hn::Gt(o.ra, bailout);
+            escapes = hn::Gt(o.sa, escapeAbove);
         }
         const auto now = hn::AndNot(escaped, escapes);  // escaping at this iteration
         // Branch-free: which lanes escape is data-dependent, so a branch here would mispredict.
         frozen.n = hn::IfThenElse(now, hn::Set(d, static_cast<T>(k)), frozen.n);
-        frozen.ra = hn::IfThenElse(now, o.ra, frozen.ra);
+        frozen.sa = hn::IfThenElse(now, o.sa, frozen.sa);
         if constexpr (Var == Variant::Dual) {  // |b| is only needed at exit: keep b itself
             frozen.b = {hn::IfThenElse(now, o.b.s, frozen.b.s), hn::IfThenElse(now, o.b.i, frozen.b.i),
                         hn::IfThenElse(now, o.b.j, frozen.b.j), hn::IfThenElse(now, o.b.k, frozen.b.k)};
         } else {
-            frozen.rb = hn::IfThenElse(now, o.rb, frozen.rb);
+            frozen.sb = hn::IfThenElse(now, o.sb, frozen.sb);
         }
-        if constexpr (Var == Variant::PaperCoupled) frozen.r8 = hn::IfThenElse(now, o.r8, frozen.r8);
+        if constexpr (Var == Variant::PaperCoupled) frozen.s8 = hn::IfThenElse(now, o.s8, frozen.s8);
         frozen.da = hn::IfThenElse(now, o.da, frozen.da);
         if constexpr (Var == Variant::Paper) frozen.db = hn::IfThenElse(now, o.db, frozen.db);
         frozen.trap = hn::IfThenElse(now, o.trap, frozen.trap);
@@ -219,9 +219,9 @@ HWY_INLINE void Iterate(D d, const Constants<T>& constants, Orbit<hn::Vec<D>>& o
 template <Variant Var, class D>
 HWY_INLINE void FreezeUnescaped(D /* tag */, hn::Mask<D> unescaped, const Orbit<hn::Vec<D>>& o,
                                 Frozen<hn::Vec<D>>& frozen) {
-    frozen.ra = hn::IfThenElse(unescaped, o.ra, frozen.ra);
-    frozen.rb = hn::IfThenElse(unescaped, Var == Variant::Dual ? Norm(o.b) : o.rb, frozen.rb);
-    frozen.r8 = hn::IfThenElse(unescaped, o.r8, frozen.r8);
+    frozen.sa = hn::IfThenElse(unescaped, o.sa, frozen.sa);
+    frozen.sb = hn::IfThenElse(unescaped, Var == Variant::Dual ? SquaredNorm(o.b) : o.sb, frozen.sb);
+    frozen.s8 = hn::IfThenElse(unescaped, o.s8, frozen.s8);
     frozen.trap = hn::IfThenElse(unescaped, o.trap, frozen.trap);
 }
 
@@ -229,7 +229,7 @@ HWY_INLINE void FreezeUnescaped(D /* tag */, hn::Mask<D> unescaped, const Orbit<
 /// each orbit's point index within the chunk (exact in T: a chunk is at most kChunk points).
 template <typename T>
 struct OrbitStore {
-    enum Field { kA = 0, kB = 4, kRa = 8, kRb, kR8, kDa, kDb, kTrap, kIndex, kFields };
+    enum Field { kA = 0, kB = 4, kSa = 8, kSb, kS8, kDa, kDb, kTrap, kIndex, kFields };
     T* field[kFields];
 };
 
@@ -258,9 +258,9 @@ HWY_INLINE Orbit<hn::Vec<D>> LoadOrbit(D d, const OrbitStore<T>& store, std::siz
     o.b = {hn::LoadU(d, f[S::kB] + at), hn::LoadU(d, f[S::kB + 1] + at), hn::LoadU(d, f[S::kB + 2] + at),
            hn::LoadU(d, f[S::kB + 3] + at)};
     const auto zero = hn::Zero(d);
-    o.ra = Carried<Var>::ra ? hn::LoadU(d, f[S::kRa] + at) : zero;
-    o.rb = Carried<Var>::rb ? hn::LoadU(d, f[S::kRb] + at) : zero;
-    o.r8 = Carried<Var>::r8 ? hn::LoadU(d, f[S::kR8] + at) : zero;
+    o.sa = Carried<Var>::sa ? hn::LoadU(d, f[S::kSa] + at) : zero;
+    o.sb = Carried<Var>::sb ? hn::LoadU(d, f[S::kSb] + at) : zero;
+    o.s8 = Carried<Var>::s8 ? hn::LoadU(d, f[S::kS8] + at) : zero;
     o.db = Carried<Var>::db ? hn::LoadU(d, f[S::kDb] + at) : zero;
     o.da = hn::LoadU(d, f[S::kDa] + at);
     o.trap = hn::LoadU(d, f[S::kTrap] + at);
@@ -293,9 +293,9 @@ HWY_INLINE std::size_t KeepOrbits(D d, const Orbit<hn::Vec<D>>& o, hn::Vec<D> in
     T* const* f = store.field;
     const hn::Vec<D> parts[8] = {o.a.s, o.a.i, o.a.j, o.a.k, o.b.s, o.b.i, o.b.j, o.b.k};
     for (int k = 0; k < 8; ++k) PackStore(d, parts[k], running, f[S::kA + k] + to);
-    if constexpr (Carried<Var>::ra) PackStore(d, o.ra, running, f[S::kRa] + to);
-    if constexpr (Carried<Var>::rb) PackStore(d, o.rb, running, f[S::kRb] + to);
-    if constexpr (Carried<Var>::r8) PackStore(d, o.r8, running, f[S::kR8] + to);
+    if constexpr (Carried<Var>::sa) PackStore(d, o.sa, running, f[S::kSa] + to);
+    if constexpr (Carried<Var>::sb) PackStore(d, o.sb, running, f[S::kSb] + to);
+    if constexpr (Carried<Var>::s8) PackStore(d, o.s8, running, f[S::kS8] + to);
     if constexpr (Carried<Var>::db) PackStore(d, o.db, running, f[S::kDb] + to);
     PackStore(d, o.da, running, f[S::kDa] + to);
     PackStore(d, o.trap, running, f[S::kTrap] + to);
@@ -303,11 +303,12 @@ HWY_INLINE std::size_t KeepOrbits(D d, const Orbit<hn::Vec<D>>& o, hn::Vec<D> in
     return hn::CountTrue(d, running);
 }
 
-/// What a finished lane leaves in the result arrays until FinishEstimates: n, ra, rb and trap
-/// final; r holds the paper's db or paper-coupled's 8-D norm, de the derivative.
+/// What a finished lane leaves in the result arrays until FinishEstimates: n final; ra, rb and
+/// trap squared; r holds the paper's db or paper-coupled's 8-D norm squared, de the derivative
+/// squared.
 template <Variant Var, class V>
 HWY_INLINE V PendingR(const Frozen<V>& f) {
-    return Var == Variant::Paper ? f.db : f.r8;
+    return Var == Variant::Paper ? f.db : f.s8;
 }
 
 /// Every lane's outputs to entries at .. at + lanes - 1 (a full vector of the chunk's first
@@ -322,8 +323,8 @@ HWY_INLINE void WriteAll(D d, const Frozen<hn::Vec<D>>& f, const EscapeBatch<T>&
         hn::StoreU(hn::DemoteTo(di, f.n), di, out.n + at);
     }
     hn::StoreU(PendingR<Var>(f), d, out.r + at);
-    hn::StoreU(f.ra, d, out.ra + at);
-    hn::StoreU(f.rb, d, out.rb + at);
+    hn::StoreU(f.sa, d, out.ra + at);
+    hn::StoreU(f.sb, d, out.rb + at);
     hn::StoreU(f.da, d, out.de + at);
     hn::StoreU(f.trap, d, out.trap + at);
 }
@@ -333,7 +334,7 @@ template <Variant Var, class D, typename T = hn::TFromD<D>>
 HWY_INLINE void WriteFinished(D d, const Frozen<hn::Vec<D>>& f, hn::Mask<D> finished, hn::Vec<D> index,
                               const EscapeBatch<T>& out) {
     HWY_ALIGN T values[7][kMaxLanes<T>];
-    const hn::Vec<D> fields[7] = {index, f.n, PendingR<Var>(f), f.ra, f.rb, f.da, f.trap};
+    const hn::Vec<D> fields[7] = {index, f.n, PendingR<Var>(f), f.sa, f.sb, f.da, f.trap};
     for (int k = 0; k < 7; ++k) hn::Store(fields[k], d, values[k]);
     static_assert(kMaxLanes<T> <= 64, "a vector's mask bits fit 64 bits");
     std::uint8_t bytes[8] = {};
@@ -352,10 +353,11 @@ HWY_INLINE void WriteFinished(D d, const Frozen<hn::Vec<D>>& f, hn::Mask<D> fini
     }
 }
 
-/// r and the DE of one vector from the pending results (n, r, ra, rb, de at index 0).
+/// The square roots, r and the DE of one vector from the pending results (PendingR): n, r, ra,
+/// rb, de and trap at index 0.
 template <Variant Var, class D, typename T = hn::TFromD<D>>
-HWY_INLINE void FinishVector(D d, const Constants<T>& constants, const std::int32_t* n, T* r, const T* ra, const T* rb,
-                             T* de) {
+HWY_INLINE void FinishVector(D d, const Constants<T>& constants, const std::int32_t* n, T* r, T* ra, T* rb, T* de,
+                             T* trap) {
     using V = hn::Vec<D>;
     V count;
     if constexpr (sizeof(T) == 4) {
@@ -364,51 +366,54 @@ HWY_INLINE void FinishVector(D d, const Constants<T>& constants, const std::int3
         count = hn::PromoteTo(d, hn::LoadU(hn::Rebind<std::int32_t, D>(), n));
     }
     const auto escaped = hn::Gt(count, hn::Zero(d));
-    const V bailout = hn::Set(d, constants.bailout);
+    const V escapeAbove = hn::Set(d, constants.escapeAbove);
     const V one = hn::Set(d, 1);
     const V two = hn::Set(d, 2);
-    const V raOut = hn::LoadU(d, ra);
+    const V saOut = hn::LoadU(d, ra);
+    const V raOut = hn::Sqrt(saOut);
     const V pending = hn::LoadU(d, r);
-    const V daOut = hn::LoadU(d, de);
+    const V daOut = hn::Sqrt(hn::LoadU(d, de));
     // Non-escaped lanes get a harmless argument for the log.
-    V radius, estimate;
+    V radius, estimate, rbOut;
     if constexpr (Var == Variant::Paper) {
-        const V rbOut = hn::LoadU(d, rb);
+        const V sbOut = hn::LoadU(d, rb);
+        rbOut = hn::Sqrt(sbOut);
         radius = StdMax(raOut, rbOut);
         // max, not min: min is 0 wherever one part never escapes and the marcher stalls.
-        const auto aOut = hn::And(escaped, hn::Gt(raOut, bailout));
-        const auto bOut = hn::And(escaped, hn::Gt(rbOut, bailout));
+        const auto aOut = hn::And(escaped, hn::Gt(saOut, escapeAbove));
+        const auto bOut = hn::And(escaped, hn::Gt(sbOut, escapeAbove));
         const V deA = hn::IfThenElseZero(aOut, PartEstimate(d, hn::IfThenElse(aOut, raOut, two), daOut));
-        const V deB = hn::IfThenElseZero(bOut, PartEstimate(d, hn::IfThenElse(bOut, rbOut, two), pending));
+        const V deB = hn::IfThenElseZero(bOut, PartEstimate(d, hn::IfThenElse(bOut, rbOut, two), hn::Sqrt(pending)));
         estimate = StdMax(deA, deB);
     } else {
-        radius = Var == Variant::PaperCoupled ? pending : raOut;
+        rbOut = hn::Sqrt(hn::LoadU(d, rb));
+        radius = Var == Variant::PaperCoupled ? hn::Sqrt(pending) : raOut;
         estimate = hn::IfThenElseZero(escaped, PartEstimate(d, hn::IfThenElse(escaped, radius, two),
                                                             hn::IfThenElse(escaped, daOut, one)));
     }
     hn::StoreU(radius, d, r);
+    hn::StoreU(raOut, d, ra);
+    hn::StoreU(rbOut, d, rb);
     hn::StoreU(estimate, d, de);
+    hn::StoreU(hn::Sqrt(hn::LoadU(d, trap)), d, trap);
 }
 
-/// r and the DE of every point of a chunk, once all have finished.
+/// r, the DE and the square roots of every point of a chunk, once all have finished.
 template <Variant Var, class D, typename T = hn::TFromD<D>>
 HWY_INLINE void FinishEstimates(D d, const Constants<T>& constants, const EscapeBatch<T>& out, std::size_t count) {
     const std::size_t lanes = hn::Lanes(d);
     std::size_t at = 0;
     for (; at + lanes <= count; at += lanes)
-        FinishVector<Var>(d, constants, out.n + at, out.r + at, out.ra + at, out.rb + at, out.de + at);
+        FinishVector<Var>(d, constants, out.n + at, out.r + at, out.ra + at, out.rb + at, out.de + at, out.trap + at);
     if (at == count) return;
     const std::size_t rest = count - at;
     std::int32_t n[kMaxLanes<T>] = {};
-    HWY_ALIGN T r[kMaxLanes<T>] = {}, ra[kMaxLanes<T>] = {}, rb[kMaxLanes<T>] = {}, de[kMaxLanes<T>] = {};
     std::memcpy(n, out.n + at, rest * sizeof(std::int32_t));
-    std::memcpy(r, out.r + at, rest * sizeof(T));
-    std::memcpy(ra, out.ra + at, rest * sizeof(T));
-    std::memcpy(rb, out.rb + at, rest * sizeof(T));
-    std::memcpy(de, out.de + at, rest * sizeof(T));
-    FinishVector<Var>(d, constants, n, r, ra, rb, de);
-    std::memcpy(out.r + at, r, rest * sizeof(T));
-    std::memcpy(out.de + at, de, rest * sizeof(T));
+    HWY_ALIGN T tail[5][kMaxLanes<T>] = {};
+    T* const fields[5] = {out.r + at, out.ra + at, out.rb + at, out.de + at, out.trap + at};
+    for (int k = 0; k < 5; ++k) std::memcpy(tail[k], fields[k], rest * sizeof(T));
+    FinishVector<Var>(d, constants, n, tail[0], tail[1], tail[2], tail[3], tail[4]);
+    for (int k = 0; k < 5; ++k) std::memcpy(fields[k], tail[k], rest * sizeof(T));
 }
 
 /// One chunk of at most kChunk points. Every vector runs a segment of kSegment iterations
@@ -441,7 +446,7 @@ HWY_INLINE void IterateChunk(D d, const Constants<T>& constants, const T* const*
             Iterate<Var>(d, constants, o, to, iterations, escaped, frozen);
             to = iterations;
         }
-        if constexpr (Var == Variant::Dual) frozen.rb = Norm(frozen.b);
+        if constexpr (Var == Variant::Dual) frozen.sb = SquaredNorm(frozen.b);
         auto running = hn::AndNot(escaped, liveLanes);
         auto finished = hn::And(escaped, liveLanes);
         if (to == iterations) {
@@ -511,7 +516,7 @@ void EvaluateT(const Fractal& fractal, const PointBatch<T>& points, const Escape
         constants.ca[k] = static_cast<T>(component(fractal.c.a, k));
         constants.cb[k] = static_cast<T>(component(fractal.c.b, k));
     }
-    constants.bailout = static_cast<T>(fractal.bailout);
+    constants.escapeAbove = squaredBailout<T>(fractal.bailout);
     constants.iterations = fractal.iterations;
     switch (fractal.variant) {
         case Variant::Paper: return IterateAll<Variant::Paper>(constants, points, results);

@@ -22,65 +22,72 @@ template <Variant V>
 Escape iterate(const Fractal& fractal, const DualQuat& start) {
     const Quat ca = fractal.c.a;
     const Quat cb = fractal.c.b;
-    const double bailout = fractal.bailout;
+    // Squared throughout: sa = |a|^2, sb = |b|^2, the derivatives squared; sa > escapeAbove is
+    // exactly |a| > R (squaredBailout). Square roots once, after the loop.
+    const double escapeAbove = squaredBailout<double>(fractal.bailout);
     Quat a = start.a;
     Quat b = start.b;
-    double ra = norm(a);
-    double rb = norm(b);
-    double da = 1.0;  // paper, dual: |da|; paper-coupled: the 8-D dr
+    double sa = dot4(a, a);
+    double sb = dot4(b, b);
+    double s8 = sa + sb;  // paper-coupled: the 8-D norm squared
+    double da = 1.0;      // paper, dual: |da|^2; paper-coupled: the 8-D dr^2
     double db = 1.0;
-    double trap = ra;
+    double trap = sa;
     Escape result;
     for (int k = 1; k <= fractal.iterations; ++k) {
         if constexpr (V == Variant::Paper) {
-            da *= 2.0 * ra;
-            db *= 2.0 * rb;
+            da *= 4.0 * sa;
+            db *= 4.0 * sb;
             a = square(a) + ca;
             b = square(b) + cb;
         } else if constexpr (V == Variant::PaperCoupled) {
-            da *= 2.0 * std::sqrt(ra * ra + rb * rb);
+            da *= 4.0 * s8;
             a = square(a) + ca;
             b = square(b) + cb;
         } else {
-            da *= 2.0 * ra;
+            da *= 4.0 * sa;
             const Quat previous = a;  // b must use the old a
             a = square(a) + ca;
             b = symmetricProduct(previous, b) + cb;
         }
-        ra = norm(a);
-        rb = norm(b);
-        trap = std::min(trap, ra);
+        sa = dot4(a, a);
+        if constexpr (V != Variant::Dual) sb = dot4(b, b);  // dual: only needed at exit
+        trap = std::min(trap, sa);
         bool escaped;
         if constexpr (V == Variant::Paper) {
-            escaped = ra > bailout || rb > bailout;
+            escaped = sa > escapeAbove || sb > escapeAbove;
         } else if constexpr (V == Variant::PaperCoupled) {
-            escaped = std::sqrt(ra * ra + rb * rb) > bailout;
+            s8 = sa + sb;
+            escaped = s8 > escapeAbove;
         } else {
-            escaped = ra > bailout;
+            escaped = sa > escapeAbove;
         }
         if (escaped) {
             result.n = k;
             break;
         }
     }
+    if constexpr (V == Variant::Dual) sb = dot4(b, b);
+    const double ra = std::sqrt(sa);
+    const double rb = std::sqrt(sb);
     result.ra = ra;
     result.rb = rb;
-    result.trap = trap;
+    result.trap = std::sqrt(trap);
     result.exit = {a, b};
     if constexpr (V == Variant::Paper) {
         result.r = std::max(ra, rb);
         if (result.n != 0) {
             // max, not min: min is 0 wherever one part never escapes and the marcher stalls.
-            const double deA = ra > bailout ? partEstimate(ra, da) : 0.0;
-            const double deB = rb > bailout ? partEstimate(rb, db) : 0.0;
+            const double deA = sa > escapeAbove ? partEstimate(ra, std::sqrt(da)) : 0.0;
+            const double deB = sb > escapeAbove ? partEstimate(rb, std::sqrt(db)) : 0.0;
             result.de = std::max(deA, deB);
         }
     } else if constexpr (V == Variant::PaperCoupled) {
-        result.r = std::sqrt(ra * ra + rb * rb);
-        if (result.n != 0) result.de = partEstimate(result.r, da);
+        result.r = std::sqrt(s8);
+        if (result.n != 0) result.de = partEstimate(result.r, std::sqrt(da));
     } else {
         result.r = ra;
-        if (result.n != 0) result.de = partEstimate(ra, da);
+        if (result.n != 0) result.de = partEstimate(ra, std::sqrt(da));
     }
     return result;
 }
@@ -113,11 +120,12 @@ double minimumBailout(const Fractal& fractal) {
 glm::dvec3 realPartGradient(const Fractal& fractal, const Quat& start, const Quat directions[3]) {
     Quat a = start;
     Quat b[3] = {directions[0], directions[1], directions[2]};
+    const double escapeAbove = squaredBailout<double>(fractal.bailout);
     for (int k = 1; k <= fractal.iterations; ++k) {
         const Quat previous = a;
         a = square(a) + fractal.c.a;
         for (Quat& tangent : b) tangent = symmetricProduct(previous, tangent);  // c_b = 0
-        if (norm(a) > fractal.bailout) break;
+        if (dot4(a, a) > escapeAbove) break;
     }
     const double normSquared = dot4(a, a);
     if (normSquared == 0.0) return glm::dvec3(0.0);

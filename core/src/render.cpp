@@ -171,15 +171,17 @@ public:
         stretch_ = stretchOf(slice_).max;
         footprint_ = 2.0 * camera_.tanHalfFov / camera_.height;
         samples_ = std::max(1, settings_.samples);
-        // The derivative before escape is at most (2 R)^N (each factor 2 |a_k| with |a_k| <= R):
-        // the float kernel only where that stays well below float's largest value, 2^128, and
+        // The derivative before escape is at most (2 R)^N (each factor 2 |a_k| with |a_k| <= R),
+        // and the kernel carries it squared, (2 R)^2N: the float kernel only where that stays
+        // below float's largest value, 2^128, with room to spare (2^120), and
         // where the start points, c and their squares do too (an infinite square gives NaNs,
         // which never escape: a false hit).
         const double reach = stretch_ * (glm::length(bounds_.center) + bounds_.radius);  // of any point, in 8-D
         double largest = 0.0;
         for (int k = 0; k < 8; ++k)
             largest = std::max({largest, std::abs(slice_.origin[k]) + reach, std::abs(component(fractal_.c, k))});
-        floatKernel_ = fractal_.iterations * std::log2(2.0 * std::max(fractal_.bailout, 1.0)) < 100.0 && largest < 1e15;
+        floatKernel_ =
+            2.0 * fractal_.iterations * std::log2(2.0 * std::max(fractal_.bailout, 1.0)) < 120.0 && largest < 1e15;
         analytic_ = settings_.normals == NormalMethod::Analytic ||
                     (settings_.normals == NormalMethod::Auto && fractal_.variant == Variant::Dual);
         for (int axis = 0; axis < 3; ++axis) {

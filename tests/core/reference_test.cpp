@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -177,6 +178,38 @@ TEST(ReferenceContainment, MinimumBailoutKeepsSetPointsInside) {
         fractal.bailout = dqj::minimumBailout(fractal);
         EXPECT_EQ(dqj::evaluate(fractal, start).n, 0) << dqj::variantName(variant);
     }
+}
+
+// The loop tests escape on squared norms: s > squaredBailout(R) must be exactly sqrt(s) > R,
+// checked on the doubles and floats next to R^2 for bailouts from 1 to 1e150 (and the edges).
+template <typename T>
+void expectSquaredBailoutExact(double bailout) {
+    const T above = dqj::squaredBailout<T>(bailout);
+    const T r = static_cast<T>(bailout);
+    T s = r * r;
+    for (int k = 0; k < 8; ++k) s = std::nextafter(s, T(0));
+    for (int k = 0; k < 16; ++k, s = std::nextafter(s, std::numeric_limits<T>::infinity()))
+        EXPECT_EQ(s > above, std::sqrt(s) > r) << "R = " << bailout << ", s = " << s;
+}
+
+TEST(ReferenceContainment, SquaredBailoutIsExactlyTheBailout) {
+    for (double bailout : {1.0, 1.5, 2.0, 2.236067977499790, 3.0, 4.0, 7.3, 20.0, 1e3, 12345.678, 1e19, 1e150}) {
+        expectSquaredBailoutExact<double>(bailout);
+        if (bailout < 1e19) expectSquaredBailoutExact<float>(bailout);
+    }
+    std::mt19937_64 random(3);
+    std::uniform_real_distribution<double> uniform(1.0, 64.0);
+    for (int k = 0; k < 2000; ++k) {
+        const double bailout = uniform(random);
+        expectSquaredBailoutExact<double>(bailout);
+        expectSquaredBailoutExact<float>(bailout);
+    }
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    EXPECT_EQ(dqj::squaredBailout<double>(kInf), kInf);  // nothing finite escapes
+    EXPECT_TRUE(std::isnan(dqj::squaredBailout<double>(std::nan(""))));
+    EXPECT_EQ(dqj::squaredBailout<double>(-1.0), -kInf);  // everything escapes, as sqrt(s) > -1
+    EXPECT_EQ(dqj::squaredBailout<float>(1e30), std::numeric_limits<float>::max());  // R^2 overflows float
+    EXPECT_EQ(dqj::squaredBailout<double>(0.0), 0.0);
 }
 
 std::string rowName(const testing::TestParamInfo<ReferenceRow>& info) {

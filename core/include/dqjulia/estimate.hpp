@@ -2,9 +2,13 @@
 //
 // zeta <- zeta^2 + c for at most N iterations with bailout R. Per iteration the
 // derivative(s) are updated from the current state, then the state, then escape
-// is tested. Cost: at most N iterations of two quaternion squares per point.
+// is tested. Norms and derivatives are carried squared (no square root in the loop);
+// their square roots are taken once, at exit. Cost: at most N iterations of two
+// quaternion squares per point.
 #pragma once
 
+#include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -40,6 +44,25 @@ DQJ_API Escape evaluate(const Fractal& fractal, const DualQuat& start);
 
 /// Only the distance estimate (same as evaluate(...).de).
 DQJ_API double distanceEstimate(const Fractal& fractal, const DualQuat& start);
+
+/// The largest x of type T with sqrt(x) <= bailout (square roots correctly rounded), so that
+/// `s > squaredBailout<T>(R)` is exactly `sqrt(s) > R` for a squared norm s: the iteration tests
+/// escape on squared norms and takes square roots once, at exit. max() when R^2 overflows (only
+/// an infinite s escapes), +inf for an infinite R, NaN for a NaN R (nothing escapes), -inf for a
+/// negative R (everything escapes, as sqrt(s) > R would).
+template <typename T>
+T squaredBailout(double bailout) {
+    const T r = static_cast<T>(bailout);
+    if (!(r < std::numeric_limits<T>::infinity())) return r;
+    if (r < 0) return -std::numeric_limits<T>::infinity();
+    T x = r * r;
+    if (x == std::numeric_limits<T>::infinity()) x = std::numeric_limits<T>::max();
+    while (x > 0 && std::sqrt(x) > r) x = std::nextafter(x, T(0));
+    for (T up = std::nextafter(x, std::numeric_limits<T>::infinity()); std::sqrt(up) <= r;
+         up = std::nextafter(x, std::numeric_limits<T>::infinity()))
+        x = up;
+    return x;
+}
 
 /// Any quaternion orbit with |q| > r_K(c) = (1 + sqrt(1 + 4|c|)) / 2 escapes.
 DQJ_API double containmentRadius(const Quat& c);
