@@ -8,15 +8,16 @@
 // Two precisions:
 //  - double: n, r, ra, rb and trap are bit-identical to evaluate() (same operations in the same
 //    order, no fused multiply-add); de differs from evaluate() only through the logarithm
-//    (Highway's vector log, within 4 ulp), a relative difference below 1e-14.
+//    (Highway's vector log, within 4 ulp) and 1/d (Newton steps from the squared derivative),
+//    a relative difference below 1e-14.
 //  - float: about twice the points per instruction. Escape counts equal evaluate()'s except
 //    where the double orbit passes within float rounding of the bailout at the deciding
 //    iteration: the float orbit carries a relative error of about 2^-24 times the derivative
 //    |d a_k / d a_0| (floatErrorBound() in tests/core/batch_test.cpp makes this precise), so near
 //    the set's surface, where the derivative is large, |a_k| may land on the other side of R.
 //    r, ra, rb, de and trap agree to about 1e-6 relative where the counts agree and the
-//    derivative is small. The derivative overflows float beyond about 3e38 (de becomes 0); use
-//    double for large N.
+//    derivative is small. The kernel carries the derivative squared, which overflows float
+//    beyond about 3e38, a derivative of 1.8e19 (de becomes 0); use double for large N.
 // The exit state (Escape::exit) is not computed.
 //
 // Cost: as evaluate() per point, divided by the lanes per vector (8 doubles or 16 floats with
