@@ -409,11 +409,18 @@ HWY_INLINE void FinishVector(D d, const Constants<T>& constants, const std::int3
         // max, not min: min is 0 wherever one part never escapes and the marcher stalls.
         const auto aOut = hn::And(escaped, hn::Gt(saOut, escapeAbove));
         const auto bOut = hn::And(escaped, hn::Gt(sbOut, escapeAbove));
-        const V deA = hn::IfThenElseZero(aOut, PartEstimate(d, hn::IfThenElse(aOut, raOut, two),
-                                                            hn::IfThenElse(aOut, daOut, one)));
-        const V deB = hn::IfThenElseZero(bOut, PartEstimate(d, hn::IfThenElse(bOut, rbOut, two),
-                                                            hn::IfThenElse(bOut, pending, one)));
-        estimate = StdMax(deA, deB);
+        // max(deA, deB) with deX = 0 for a part that did not escape, in one logarithm where a
+        // lane's parts did not both escape (nearly all): that part's estimate, the a part's
+        // as it is and the b part's as max(0, deB), StdMax's value for a NaN too. Lanes where
+        // both escaped take the second logarithm.
+        const V single = PartEstimate(d, hn::IfThenElse(aOut, raOut, hn::IfThenElse(bOut, rbOut, two)),
+                                      hn::IfThenElse(aOut, daOut, hn::IfThenElse(bOut, pending, one)));
+        estimate = hn::IfThenElse(aOut, single, hn::IfThenElseZero(bOut, StdMax(hn::Zero(d), single)));
+        const auto both = hn::And(aOut, bOut);
+        if (HWY_UNLIKELY(!hn::AllFalse(d, both))) {
+            const V deB = PartEstimate(d, hn::IfThenElse(both, rbOut, two), hn::IfThenElse(both, pending, one));
+            estimate = hn::IfThenElse(both, StdMax(estimate, deB), estimate);
+        }
     } else {
         rbOut = hn::Sqrt(hn::LoadU(d, rb));
         radius = Var == Variant::PaperCoupled ? hn::Sqrt(pending) : raOut;
