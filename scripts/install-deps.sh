@@ -5,7 +5,7 @@
 set -euo pipefail
 
 packages=(
-  build-essential cmake pkg-config clang libclang-rt-14-dev ccache
+  build-essential patch cmake pkg-config clang libclang-rt-14-dev ccache
   libglm-dev nlohmann-json3-dev libcli11-dev libgtest-dev libfreetype-dev fonts-dejavu-core
   libboost-dev  # headers only: OpenVDB's, built statically by scripts/build-deps.sh with its other libraries
   debootstrap   # tests/cleanroom: the add-on's library loaded in a minimal Debian root

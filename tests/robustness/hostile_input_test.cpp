@@ -117,6 +117,25 @@ TEST_F(Hostile, ATruncatedVdbIsRefusedWithAShortReason) {
     EXPECT_EQ(result.exitCode, 0) << result.err;
 }
 
+// The VDB files the fuzzer found damaging (tests/fuzz/regressions/vdb), through the command in
+// every build: each is refused with a short reason and nothing written. The first overran a
+// leaf's buffer inside OpenVDB 10.0.1's chunk reader (an uncompressed chunk's size read after
+// its data; scripts/patches/openvdb-10.0.1-compression-bounds.patch).
+TEST_F(Hostile, VdbFilesTheFuzzerFoundAreRefusedWithAShortReason) {
+    std::size_t files = 0;
+    for (const auto& entry : fs::directory_iterator(DQJ_VDB_REGRESSIONS)) {
+        ++files;
+        const std::string name = entry.path().filename().string();
+        const auto result =
+            run("render -q -W 32 -H 24 --voxels '" + entry.path().string() + "' -o " + path("voxels.png"));
+        EXPECT_EQ(result.exitCode, 1) << name << ": " << result.err;
+        EXPECT_CONTAINS(result.err, "cannot read '");
+        EXPECT_LT(result.err.size(), 400u) << name << ": " << result.err;
+        EXPECT_FALSE(fs::exists(dir_ / "voxels.png")) << name;
+    }
+    EXPECT_GE(files, 1u);
+}
+
 // --- The JSON path: nesting, size, duplicates, NUL bytes ---------------------------------
 
 TEST_F(Hostile, DeepNestingIsRefusedNotAStackOverflow) {
