@@ -398,13 +398,13 @@ HWY_INLINE void FinishVector(D d, const Constants<T>& constants, const std::int3
     const V two = hn::Set(d, 2);
     const V saOut = hn::LoadU(d, ra);
     const V raOut = hn::Sqrt(saOut);
+    const V sbOut = hn::LoadU(d, rb);
+    const V rbOut = hn::Sqrt(sbOut);
     const V pending = hn::LoadU(d, r);
     const V daOut = hn::LoadU(d, de);  // squared
     // Non-escaped lanes get a harmless argument for the log.
-    V radius, estimate, rbOut;
+    V radius, estimate;
     if constexpr (Var == Variant::Paper) {
-        const V sbOut = hn::LoadU(d, rb);
-        rbOut = hn::Sqrt(sbOut);
         radius = StdMax(raOut, rbOut);
         // max, not min: min is 0 wherever one part never escapes and the marcher stalls.
         const auto aOut = hn::And(escaped, hn::Gt(saOut, escapeAbove));
@@ -422,7 +422,6 @@ HWY_INLINE void FinishVector(D d, const Constants<T>& constants, const std::int3
             estimate = hn::IfThenElse(both, StdMax(estimate, deB), estimate);
         }
     } else {
-        rbOut = hn::Sqrt(hn::LoadU(d, rb));
         radius = Var == Variant::PaperCoupled ? hn::Sqrt(pending) : raOut;
         estimate = hn::IfThenElseZero(escaped, PartEstimate(d, hn::IfThenElse(escaped, radius, two),
                                                             hn::IfThenElse(escaped, daOut, one)));
