@@ -508,6 +508,11 @@ def compare(args, dqjulia, work):
                 double_share, float_share = float(parts[8].rstrip("%")), float(parts[9].rstrip("%"))
                 rows.append((f"kernel {parts[0]} share of peak", f"double {double_share:.1f}%", f"float {float_share:.1f}%",
                              "", ">= 35% / >= 50%", double_share >= 35.0 and float_share >= 50.0))
+            if parts and parts[0] in ("paper", "paper-coupled", "dual") and len(parts) >= 12:
+                # The same with every lane busy (the loop workload: bounded orbits, N = 48).
+                double_loop, float_loop = float(parts[10].rstrip("%")), float(parts[11].rstrip("%"))
+                rows.append((f"kernel {parts[0]} share of peak, every lane busy", f"double {double_loop:.1f}%",
+                             f"float {float_loop:.1f}%", "the loop alone", "", None))
 
     width = [max(len(str(row[i])) for row in rows + [("measure", "dqjulia", "other", "ratio", "target", "")]) for i in range(5)]
     print()
