@@ -3,11 +3,12 @@
 // namespace (N_AVX3, N_AVX2, ..., N_EMU128), and HWY_EXPORT builds the table that
 // HWY_DYNAMIC_DISPATCH picks from at run time.
 //
-// Every lane of a vector runs one point. Lanes that escape keep iterating with the others
-// (their values may overflow to inf or NaN, which is harmless) while their outputs are frozen
-// at the iteration they escaped. A vector runs a segment of a few iterations; the orbits still
-// running after it are packed together, so a lane idles behind its vector's slowest point for
-// at most a segment (IterateChunk). In double precision the arithmetic repeats estimate.cpp's
+// Every lane of a vector runs one point. A lane that escapes either stops (AVX-512: its updates
+// are masked away) or keeps iterating with the others (its values may overflow to inf or NaN,
+// which is harmless) while its outputs are frozen at the iteration it escaped (kOrbitStops).
+// A vector runs a segment of a few iterations; the orbits still running after it are packed
+// together, so a lane idles behind its vector's slowest point for at most a segment
+// (IterateChunk). In double precision the arithmetic repeats estimate.cpp's
 // operations in the same order without fused multiply-add (this file is compiled with
 // -ffp-contract=off), so results are bit-identical to evaluate() apart from the logarithm in
 // the DE. In float, multiply-adds are fused for speed.
@@ -180,52 +181,90 @@ HWY_INLINE Orbit<hn::Vec<D>> StartOrbit(D d, const T* const* in, std::size_t at)
     return o;
 }
 
-/// Iterations from + 1 .. to of one vector of orbits. Lanes that escape join `escaped`, their
-/// outputs frozen in `frozen`; lanes already in it (escaped, or holding no orbit) are left alone.
-/// Escaped lanes keep iterating with the others (their values may overflow to inf or NaN,
-/// which is harmless); the vector stops early once every lane has escaped.
-template <Variant Var, class D, typename T = hn::TFromD<D>>
-HWY_INLINE void Iterate(D d, const Constants<T>& constants, Orbit<hn::Vec<D>>& o, int from, int to,
-                        hn::Mask<D>& escaped, Frozen<hn::Vec<D>>& frozen) {
-    using V = hn::Vec<D>;
-    V ca[4], cb[4];
-    for (int k = 0; k < 4; ++k) {
-        ca[k] = hn::Set(d, constants.ca[k]);
-        cb[k] = hn::Set(d, constants.cb[k]);
+/// Where an escaped lane's outputs are kept. With AVX-512's mask registers its orbit stops: its
+/// updates are merge-masked away (the mask folds into the instruction that computes the value),
+/// so the orbit holds the outputs and only the escape count needs a blend. The mask is then on
+/// the chain from one iteration to the next, so two vectors step together, each filling the
+/// other's latency (kStepped). Without mask registers a blend is an instruction of its own: the
+/// orbit runs on (into inf or NaN, harmlessly), its outputs copied into `Frozen` as it escapes
+/// (fewer blends), one vector at a time. On AVX-512 the orbits stop where dqjulia_bench measured
+/// it faster: dual, and paper-coupled in float. Paper's orbit carries two vectors more (db and
+/// |b|^2), two of them spill out of the 32 registers; paper-coupled in double lost 10 % on the
+/// bench's points (bench/README.md, "Stopped orbits").
+#if HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL
+constexpr bool kMaskRegisters = true;
+#else
+constexpr bool kMaskRegisters = false;
+#endif
+template <Variant Var, typename T>
+constexpr bool kOrbitStops = kMaskRegisters &&
+                             (Var == Variant::Dual || (Var == Variant::PaperCoupled && sizeof(T) == 4));
+/// Vectors of orbits stepped together (Iterate).
+template <Variant Var, typename T>
+constexpr int kStepped = kOrbitStops<Var, T> ? 2 : 1;
+
+/// `updated` in the lanes still running, `old` in the others when the orbit stops (kOrbitStops).
+template <Variant Var, class M, class V>
+HWY_INLINE V Step(M running, V updated, V old) {
+    if constexpr (kOrbitStops<Var, hn::TFromV<V>>) {
+        return hn::IfThenElse(running, updated, old);
+    } else {
+        return updated;
     }
-    const V escapeAbove = hn::Set(d, constants.escapeAbove);
-    const V four = hn::Set(d, 4);
-    for (int k = from + 1; k <= to; ++k) {
-        if constexpr (Var == Variant::Paper) {
-            o.da = hn::Mul(o.da, hn::Mul(four, o.sa));
-            o.db = hn::Mul(o.db, hn::Mul(four, o.sb));
-            o.a = SquarePlus(d, o.a, ca);
-            o.b = SquarePlus(d, o.b, cb);
-        } else if constexpr (Var == Variant::PaperCoupled) {
-            o.da = hn::Mul(o.da, hn::Mul(four, o.s8));
-            o.a = SquarePlus(d, o.a, ca);
-            o.b = SquarePlus(d, o.b, cb);
-        } else {
-            o.da = hn::Mul(o.da, hn::Mul(four, o.sa));
-            const QuatV<V> previous = o.a;  // b must use the old a
-            o.a = SquarePlus(d, o.a, ca);
-            o.b = SymmetricPlus(d, previous, o.b, cb);
-        }
-        o.sa = SquaredNorm(o.a);
-        if constexpr (Var != Variant::Dual) o.sb = SquaredNorm(o.b);  // dual: only needed at exit
-        o.trap = StdMin(o.trap, o.sa);
-        hn::Mask<D> escapes;
-        if constexpr (Var == Variant::Paper) {
-            escapes = hn::Or(hn::Gt(o.sa, escapeAbove), hn::Gt(o.sb, escapeAbove));
-        } else if constexpr (Var == Variant::PaperCoupled) {
-            o.s8 = hn::Add(o.sa, o.sb);
-            escapes = hn::Gt(o.s8, escapeAbove);
-        } else {
-            escapes = hn::Gt(o.sa, escapeAbove);
-        }
-        const auto now = hn::AndNot(escaped, escapes);  // escaping at this iteration
-        // Branch-free: which lanes escape is data-dependent, so a branch here would mispredict.
-        frozen.n = hn::IfThenElse(now, hn::Set(d, static_cast<T>(k)), frozen.n);
+}
+template <Variant Var, class M, class V>
+HWY_INLINE QuatV<V> Step(M running, const QuatV<V>& updated, const QuatV<V>& old) {
+    return {Step<Var>(running, updated.s, old.s), Step<Var>(running, updated.i, old.i),
+            Step<Var>(running, updated.j, old.j), Step<Var>(running, updated.k, old.k)};
+}
+
+/// The fractal's constants as vectors.
+template <class V>
+struct ConstantsV {
+    V ca[4], cb[4], escapeAbove, four;
+};
+
+/// Iteration k of one vector of orbits. Lanes that escape join `escaped`, with k in `frozen.n`;
+/// lanes already in it (escaped, or holding no orbit) are left alone. Their other outputs are in
+/// the orbit (kOrbitStops: it stopped) or in `frozen` (the orbit runs on).
+template <Variant Var, class D, typename T = hn::TFromD<D>>
+HWY_INLINE void Step(D d, const ConstantsV<hn::Vec<D>>& c, int k, Orbit<hn::Vec<D>>& o, hn::Mask<D>& escaped,
+                     Frozen<hn::Vec<D>>& frozen) {
+    using V = hn::Vec<D>;
+    const auto running = hn::Not(escaped);
+    // Norms, the 8-D sum and the trap need no mask: from a stopped orbit they come out unchanged
+    // (the same operations on the same values; trap <= |a|^2 already).
+    if constexpr (Var == Variant::Paper) {
+        o.da = Step<Var>(running, hn::Mul(o.da, hn::Mul(c.four, o.sa)), o.da);
+        o.db = Step<Var>(running, hn::Mul(o.db, hn::Mul(c.four, o.sb)), o.db);
+        o.a = Step<Var>(running, SquarePlus(d, o.a, c.ca), o.a);
+        o.b = Step<Var>(running, SquarePlus(d, o.b, c.cb), o.b);
+    } else if constexpr (Var == Variant::PaperCoupled) {
+        o.da = Step<Var>(running, hn::Mul(o.da, hn::Mul(c.four, o.s8)), o.da);
+        o.a = Step<Var>(running, SquarePlus(d, o.a, c.ca), o.a);
+        o.b = Step<Var>(running, SquarePlus(d, o.b, c.cb), o.b);
+    } else {
+        o.da = Step<Var>(running, hn::Mul(o.da, hn::Mul(c.four, o.sa)), o.da);
+        const QuatV<V> previous = o.a;  // b must use the old a
+        o.a = Step<Var>(running, SquarePlus(d, o.a, c.ca), o.a);
+        o.b = Step<Var>(running, SymmetricPlus(d, previous, o.b, c.cb), o.b);
+    }
+    o.sa = SquaredNorm(o.a);
+    if constexpr (Var != Variant::Dual) o.sb = SquaredNorm(o.b);  // dual: only needed at exit
+    o.trap = StdMin(o.trap, o.sa);
+    hn::Mask<D> escapes;
+    if constexpr (Var == Variant::Paper) {
+        escapes = hn::Or(hn::Gt(o.sa, c.escapeAbove), hn::Gt(o.sb, c.escapeAbove));
+    } else if constexpr (Var == Variant::PaperCoupled) {
+        o.s8 = hn::Add(o.sa, o.sb);
+        escapes = hn::Gt(o.s8, c.escapeAbove);
+    } else {
+        escapes = hn::Gt(o.sa, c.escapeAbove);
+    }
+    const auto now = hn::AndNot(escaped, escapes);  // escaping at this iteration
+    // Branch-free: which lanes escape is data-dependent, so a branch here would mispredict.
+    frozen.n = hn::IfThenElse(now, hn::Set(d, static_cast<T>(k)), frozen.n);
+    if constexpr (!kOrbitStops<Var, T>) {
         frozen.sa = hn::IfThenElse(now, o.sa, frozen.sa);
         if constexpr (Var == Variant::Dual) {  // |b| is only needed at exit: keep b itself
             frozen.b = {hn::IfThenElse(now, o.b.s, frozen.b.s), hn::IfThenElse(now, o.b.i, frozen.b.i),
@@ -237,8 +276,29 @@ HWY_INLINE void Iterate(D d, const Constants<T>& constants, Orbit<hn::Vec<D>>& o
         frozen.da = hn::IfThenElse(now, o.da, frozen.da);
         if constexpr (Var == Variant::Paper) frozen.db = hn::IfThenElse(now, o.db, frozen.db);
         frozen.trap = hn::IfThenElse(now, o.trap, frozen.trap);
-        escaped = hn::Or(escaped, now);
-        if (hn::AllTrue(d, escaped)) break;
+    }
+    escaped = hn::Or(escaped, now);
+}
+
+/// Iterations from + 1 .. to of K vectors of orbits, stepped together so that one's chain of
+/// dependent operations fills the other's latency. Stops early once every lane has escaped.
+template <int K, Variant Var, class D, typename T = hn::TFromD<D>>
+HWY_INLINE void Iterate(D d, const Constants<T>& constants, Orbit<hn::Vec<D>> (&o)[K], int from, int to,
+                        hn::Mask<D> (&escaped)[K], Frozen<hn::Vec<D>> (&frozen)[K]) {
+    ConstantsV<hn::Vec<D>> c;
+    for (int k = 0; k < 4; ++k) {
+        c.ca[k] = hn::Set(d, constants.ca[k]);
+        c.cb[k] = hn::Set(d, constants.cb[k]);
+    }
+    c.escapeAbove = hn::Set(d, constants.escapeAbove);
+    c.four = hn::Set(d, 4);
+    for (int k = from + 1; k <= to; ++k) {
+        bool done = true;
+        for (int v = 0; v < K; ++v) {
+            Step<Var>(d, c, k, o[v], escaped[v], frozen[v]);
+            done = done && hn::AllTrue(d, escaped[v]);
+        }
+        if (done) break;
     }
 }
 
@@ -467,43 +527,77 @@ HWY_INLINE void IterateChunk(D d, const Constants<T>& constants, const T* const*
     auto segmentEnd = [&](int from, std::size_t orbits) {
         return orbits > kPackMinimum * lanes && lanes >= 4 ? std::min(iterations, from + kSegment) : iterations;
     };
-    // Runs one vector to `to`, or on to N if most of its lanes are still running then (packing
-    // them would cost more than their idle neighbours); returns the orbits packed. Inlined: as a
-    // call, the orbit went through memory and the kernel was slower than without packing.
-    auto run = [&](Orbit<V> & o, V index, std::size_t live, int from, int to, std::size_t kept, bool direct,
-                   std::size_t at) __attribute__((always_inline)) {
-        const auto liveLanes = hn::FirstN(d, live);
-        auto escaped = hn::Not(liveLanes);
-        const V zero = hn::Zero(d);
-        Frozen<V> frozen{zero, zero, zero, zero, zero, zero, zero, {zero, zero, zero, zero}};
-        Iterate<Var>(d, constants, o, from, to, escaped, frozen);
-        if (to < iterations && 2 * hn::CountTrue(d, hn::Not(escaped)) > lanes) {
-            Iterate<Var>(d, constants, o, to, iterations, escaped, frozen);
+    // Runs K vectors (vector v at point `at` + v lanes, `live[v]` lanes holding orbits) to `to`,
+    // or on to N if most of their lanes are still running then (packing them would cost more
+    // than their idle neighbours); returns the orbits packed. Inlined: as a call, the orbit went
+    // through memory and the kernel was slower than without packing.
+    auto run = [&]<int K>(Orbit<V>(&o)[K], const V(&index)[K], const std::size_t(&live)[K], int from, int to,
+                          std::size_t kept, bool direct, std::size_t at) __attribute__((always_inline)) {
+        hn::Mask<D> liveLanes[K], escaped[K];
+        Frozen<V> frozen[K];
+        std::size_t running = 0;
+        for (int v = 0; v < K; ++v) {
+            liveLanes[v] = hn::FirstN(d, live[v]);
+            escaped[v] = hn::Not(liveLanes[v]);
+            const V zero = hn::Zero(d);
+            frozen[v] = {zero, zero, zero, zero, zero, zero, zero, {zero, zero, zero, zero}};
+        }
+        Iterate<K, Var>(d, constants, o, from, to, escaped, frozen);
+        for (int v = 0; v < K; ++v) running += hn::CountTrue(d, hn::Not(escaped[v]));
+        if (to < iterations && 2 * running > K * lanes) {
+            Iterate<K, Var>(d, constants, o, to, iterations, escaped, frozen);
             to = iterations;
         }
-        if constexpr (Var == Variant::Dual) frozen.sb = SquaredNorm(frozen.b);
-        auto running = hn::AndNot(escaped, liveLanes);
-        auto finished = hn::And(escaped, liveLanes);
-        if (to == iterations) {
-            FreezeUnescaped<Var>(d, running, o, frozen);
-            finished = liveLanes;
-            running = hn::AndNot(liveLanes, liveLanes);
+        std::size_t packed = 0;
+        for (int v = 0; v < K; ++v) {
+            auto stillRunning = hn::AndNot(escaped[v], liveLanes[v]);
+            auto finished = hn::And(escaped[v], liveLanes[v]);
+            if constexpr (kOrbitStops<Var, T>) {  // the outputs are the orbit's, escaped or not
+                frozen[v].sa = o[v].sa;
+                frozen[v].sb = Var == Variant::Dual ? SquaredNorm(o[v].b) : o[v].sb;
+                frozen[v].s8 = o[v].s8;
+                frozen[v].da = o[v].da;
+                frozen[v].db = o[v].db;
+                frozen[v].trap = o[v].trap;
+            } else if constexpr (Var == Variant::Dual) {
+                frozen[v].sb = SquaredNorm(frozen[v].b);
+            }
+            if (to == iterations) {
+                if constexpr (!kOrbitStops<Var, T>) FreezeUnescaped<Var>(d, stillRunning, o[v], frozen[v]);
+                finished = liveLanes[v];
+                stillRunning = hn::AndNot(liveLanes[v], liveLanes[v]);
+            }
+            if (direct) {
+                WriteAll<Var>(d, frozen[v], out, at + v * lanes);
+            } else {
+                WriteFinished<Var>(d, frozen[v], finished, index[v], out);
+            }
+            if (!hn::AllFalse(d, stillRunning))
+                packed += KeepOrbits<Var>(d, o[v], index[v], stillRunning, store, kept + packed);
         }
-        if (direct) {
-            WriteAll<Var>(d, frozen, out, at);
-        } else {
-            WriteFinished<Var>(d, frozen, finished, index, out);
-        }
-        return hn::AllFalse(d, running) ? std::size_t{0} : KeepOrbits<Var>(d, o, index, running, store, kept);
+        return packed;
     };
 
     int to = segmentEnd(0, count);
     std::size_t kept = 0;
-    for (std::size_t at = 0; at < count; at += lanes) {
-        const V index = hn::Iota(d, static_cast<T>(at));
+    std::size_t at = 0;
+    for (; at + kStepped<Var, T> * lanes <= count; at += kStepped<Var, T> * lanes) {
+        Orbit<V> o[kStepped<Var, T>];
+        V index[kStepped<Var, T>];
+        std::size_t live[kStepped<Var, T>];
+        for (int v = 0; v < kStepped<Var, T>; ++v) {
+            o[v] = StartOrbit<Var>(d, in, at + v * lanes);
+            index[v] = hn::Iota(d, static_cast<T>(at + v * lanes));
+            live[v] = lanes;
+        }
+        kept += run(o, index, live, 0, to, kept, true, at);
+    }
+    for (; at < count; at += lanes) {
+        Orbit<V> o[1];
+        const V index[1] = {hn::Iota(d, static_cast<T>(at))};
         if (at + lanes <= count) {
-            Orbit<V> o = StartOrbit<Var>(d, in, at);
-            kept += run(o, index, lanes, 0, to, kept, true, at);
+            o[0] = StartOrbit<Var>(d, in, at);
+            kept += run(o, index, {lanes}, 0, to, kept, true, at);
         } else {  // the tail, through zero-padded copies
             HWY_ALIGN T padded[8][kMaxLanes<T>] = {};
             const T* start[8];
@@ -511,8 +605,8 @@ HWY_INLINE void IterateChunk(D d, const Constants<T>& constants, const T* const*
                 std::memcpy(padded[k], in[k] + at, (count - at) * sizeof(T));
                 start[k] = padded[k];
             }
-            Orbit<V> o = StartOrbit<Var>(d, start, 0);
-            kept += run(o, index, count - at, 0, to, kept, false, at);
+            o[0] = StartOrbit<Var>(d, start, 0);
+            kept += run(o, index, {count - at}, 0, to, kept, false, at);
         }
     }
     for (int from = to; kept > 0; from = to) {
@@ -520,10 +614,22 @@ HWY_INLINE void IterateChunk(D d, const Constants<T>& constants, const T* const*
         const std::size_t orbits = kept;
         to = segmentEnd(from, orbits);
         kept = 0;
-        for (std::size_t at = 0; at < orbits; at += lanes) {
-            Orbit<V> o = LoadOrbit<Var>(d, store, at);
-            const V index = hn::LoadU(d, store.field[OrbitStore<T>::kIndex] + at);
-            kept += run(o, index, std::min(lanes, orbits - at), from, to, kept, false, at);
+        std::size_t next = 0;
+        for (; next + kStepped<Var, T> * lanes <= orbits; next += kStepped<Var, T> * lanes) {
+            Orbit<V> o[kStepped<Var, T>];
+            V index[kStepped<Var, T>];
+            std::size_t live[kStepped<Var, T>];
+            for (int v = 0; v < kStepped<Var, T>; ++v) {
+                o[v] = LoadOrbit<Var>(d, store, next + v * lanes);
+                index[v] = hn::LoadU(d, store.field[OrbitStore<T>::kIndex] + next + v * lanes);
+                live[v] = lanes;
+            }
+            kept += run(o, index, live, from, to, kept, false, next);
+        }
+        for (; next < orbits; next += lanes) {
+            Orbit<V> o[1] = {LoadOrbit<Var>(d, store, next)};
+            const V index[1] = {hn::LoadU(d, store.field[OrbitStore<T>::kIndex] + next)};
+            kept += run(o, index, {std::min(lanes, orbits - next)}, from, to, kept, false, next);
         }
     }
     FinishEstimates<Var>(d, constants, out, count);
