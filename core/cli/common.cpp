@@ -129,7 +129,8 @@ void FractalOptions::applyTo(Params& params) const {
         const std::size_t colon = text.rfind(':');
         const std::size_t comma = text.find(',');
         const auto first = parseAxisName(text.substr(0, std::min(comma, colon)));
-        const auto second = comma < colon ? parseAxisName(text.substr(comma + 1, colon - comma - 1)) : std::nullopt;
+        // No comma: the empty name, which names no axis (an optional in a ?: made GCC 12 warn).
+        const auto second = parseAxisName(comma < colon ? text.substr(comma + 1, colon - comma - 1) : std::string());
         double degrees = 0.0;
         bool numberOk = colon != std::string::npos;
         if (numberOk) {

@@ -91,10 +91,15 @@ Json parseLimited(const std::string& text, const std::string& source) {
         std::string result;
         for (const Frame& frame : frames) {
             if (&frame == &frames.back() && frame.object) break;
-            if (frame.object)
-                result += (result.empty() ? "" : ".") + frame.key;
-            else if (frame.elements > 0)
-                result += "[" + std::to_string(frame.elements - 1) + "]";
+            // Appended piece by piece: GCC 12 warns (-Wrestrict, a false positive) of "[" + ...
+            if (frame.object) {
+                if (!result.empty()) result += '.';
+                result += frame.key;
+            } else if (frame.elements > 0) {
+                result += '[';
+                result += std::to_string(frame.elements - 1);
+                result += ']';
+            }
         }
         return result.empty() ? last : last.empty() ? result : result + "." + last;
     };
