@@ -373,7 +373,7 @@ Runner addFarmCommand(CLI::App& app) {
             "The tasks' exit status: 0 done; 1 failed while working, a retry may help; 2 bad input, a "
             "retry cannot help; 130 interrupted (preempted), a retry helps. Retried or resubmitted "
             "tasks skip the files that exist.");
-    return [slurm, openjd, slurmCommand, openjdCommand] {
+    return [slurm, openjd, slurmCommand] {
         if (slurmCommand->parsed()) return reportErrors("farm slurm", [&] { return runSlurm(*slurm); });
         return reportErrors("farm openjd", [&] { return runOpenJd(*openjd); });
     };

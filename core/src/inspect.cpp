@@ -20,7 +20,9 @@ std::string number(double value, int precision = 4) {
 }
 
 std::string quatText(const Quat& q) {
-    return "(" + number(q.w) + ", " + number(q.x) + ", " + number(q.y) + ", " + number(q.z) + ")";
+    // "(" added to a named string: to a temporary, GCC 12 warns (-Wrestrict, a false positive).
+    const std::string parts = number(q.w) + ", " + number(q.x) + ", " + number(q.y) + ", " + number(q.z);
+    return "(" + parts + ")";
 }
 
 std::string complexText(const PartReport& part) {
