@@ -420,6 +420,30 @@ HWY_INLINE void WriteAll(D d, const Frozen<hn::Vec<D>>& f, const EscapeBatch<T>&
 template <Variant Var, class D, typename T = hn::TFromD<D>>
 HWY_INLINE void WriteFinished(D d, const Frozen<hn::Vec<D>>& f, hn::Mask<D> finished, hn::Vec<D> index,
                               const EscapeBatch<T>& out) {
+#if HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL
+    // AVX-512: masked scatters (no branch a lane).
+    if constexpr (sizeof(T) == 4 && hn::MaxLanes(d) == 16) {
+        const __m512i at = _mm512_cvttps_epi32(index.raw);
+        const __mmask16 m = finished.raw;
+        _mm512_mask_i32scatter_epi32(out.n, m, at, _mm512_cvttps_epi32(f.n.raw), 4);
+        _mm512_mask_i32scatter_ps(out.r, m, at, PendingR<Var>(f).raw, 4);
+        _mm512_mask_i32scatter_ps(out.ra, m, at, f.sa.raw, 4);
+        _mm512_mask_i32scatter_ps(out.rb, m, at, f.sb.raw, 4);
+        _mm512_mask_i32scatter_ps(out.de, m, at, f.da.raw, 4);
+        _mm512_mask_i32scatter_ps(out.trap, m, at, f.trap.raw, 4);
+        return;
+    } else if constexpr (sizeof(T) == 8 && hn::MaxLanes(d) == 8) {
+        const __m256i at = _mm512_cvttpd_epi32(index.raw);
+        const __mmask8 m = finished.raw;
+        _mm256_mask_i32scatter_epi32(out.n, m, at, _mm512_cvttpd_epi32(f.n.raw), 4);
+        _mm512_mask_i32scatter_pd(out.r, m, at, PendingR<Var>(f).raw, 8);
+        _mm512_mask_i32scatter_pd(out.ra, m, at, f.sa.raw, 8);
+        _mm512_mask_i32scatter_pd(out.rb, m, at, f.sb.raw, 8);
+        _mm512_mask_i32scatter_pd(out.de, m, at, f.da.raw, 8);
+        _mm512_mask_i32scatter_pd(out.trap, m, at, f.trap.raw, 8);
+        return;
+    }
+#endif
     HWY_ALIGN T values[7][kMaxLanes<T>];
     const hn::Vec<D> fields[7] = {index, f.n, PendingR<Var>(f), f.sa, f.sb, f.da, f.trap};
     for (int k = 0; k < 7; ++k) hn::Store(fields[k], d, values[k]);
