@@ -220,8 +220,11 @@ __attribute__((target("avx512f"))) double fmaChains512(long rounds) {
     const __m512d scale = _mm512_set1_pd(0.999999), shift = _mm512_set1_pd(1e-6);
     for (long round = 0; round < rounds; ++round)
         for (__m512d& a : acc) a = _mm512_fmadd_pd(a, scale, shift);
-    double sum = 0.0;
-    for (const __m512d& a : acc) sum += _mm512_reduce_add_pd(a);
+    double lanes[8], sum = 0.0;  // stored, not _mm512_reduce_add_pd: GCC 12's header warns on it
+    for (const __m512d& a : acc) {
+        _mm512_storeu_pd(lanes, a);
+        for (const double lane : lanes) sum += lane;
+    }
     return sum;
 }
 
@@ -235,7 +238,7 @@ __attribute__((target("avx2,fma"))) double fmaChains256(long rounds) {
     double lanes[4], sum = 0.0;
     for (const __m256d& a : acc) {
         _mm256_storeu_pd(lanes, a);
-        sum += lanes[0] + lanes[1] + lanes[2] + lanes[3];
+        for (const double lane : lanes) sum += lane;
     }
     return sum;
 }

@@ -416,31 +416,37 @@ HWY_INLINE void WriteAll(D d, const Frozen<hn::Vec<D>>& f, const EscapeBatch<T>&
     hn::StoreU(f.trap, d, out.trap + at);
 }
 
+#if HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL
+// AVX-512's masked scatters by element type: base[at[i]] = v[i] in the lanes of m.
+HWY_INLINE __m512i Int32(__m512 v) { return _mm512_cvttps_epi32(v); }
+HWY_INLINE __m256i Int32(__m512d v) { return _mm512_cvttpd_epi32(v); }
+HWY_INLINE void Scatter(std::int32_t* base, __mmask16 m, __m512i at, __m512i v) {
+    _mm512_mask_i32scatter_epi32(base, m, at, v, 4);
+}
+HWY_INLINE void Scatter(std::int32_t* base, __mmask8 m, __m256i at, __m256i v) {
+    _mm256_mask_i32scatter_epi32(base, m, at, v, 4);
+}
+HWY_INLINE void Scatter(float* base, __mmask16 m, __m512i at, __m512 v) {
+    _mm512_mask_i32scatter_ps(base, m, at, v, 4);
+}
+HWY_INLINE void Scatter(double* base, __mmask8 m, __m256i at, __m512d v) {
+    _mm512_mask_i32scatter_pd(base, m, at, v, 8);
+}
+#endif
+
 /// The `finished` lanes' outputs to the entries their indices name.
 template <Variant Var, class D, typename T = hn::TFromD<D>>
 HWY_INLINE void WriteFinished(D d, const Frozen<hn::Vec<D>>& f, hn::Mask<D> finished, hn::Vec<D> index,
                               const EscapeBatch<T>& out) {
 #if HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL
-    // AVX-512: masked scatters (no branch a lane).
-    if constexpr (sizeof(T) == 4 && hn::MaxLanes(d) == 16) {
-        const __m512i at = _mm512_cvttps_epi32(index.raw);
-        const __mmask16 m = finished.raw;
-        _mm512_mask_i32scatter_epi32(out.n, m, at, _mm512_cvttps_epi32(f.n.raw), 4);
-        _mm512_mask_i32scatter_ps(out.r, m, at, PendingR<Var>(f).raw, 4);
-        _mm512_mask_i32scatter_ps(out.ra, m, at, f.sa.raw, 4);
-        _mm512_mask_i32scatter_ps(out.rb, m, at, f.sb.raw, 4);
-        _mm512_mask_i32scatter_ps(out.de, m, at, f.da.raw, 4);
-        _mm512_mask_i32scatter_ps(out.trap, m, at, f.trap.raw, 4);
-        return;
-    } else if constexpr (sizeof(T) == 8 && hn::MaxLanes(d) == 8) {
-        const __m256i at = _mm512_cvttpd_epi32(index.raw);
-        const __mmask8 m = finished.raw;
-        _mm256_mask_i32scatter_epi32(out.n, m, at, _mm512_cvttpd_epi32(f.n.raw), 4);
-        _mm512_mask_i32scatter_pd(out.r, m, at, PendingR<Var>(f).raw, 8);
-        _mm512_mask_i32scatter_pd(out.ra, m, at, f.sa.raw, 8);
-        _mm512_mask_i32scatter_pd(out.rb, m, at, f.sb.raw, 8);
-        _mm512_mask_i32scatter_pd(out.de, m, at, f.da.raw, 8);
-        _mm512_mask_i32scatter_pd(out.trap, m, at, f.trap.raw, 8);
+    if constexpr (hn::MaxLanes(d) * sizeof(T) == 64) {  // masked scatters: no branch a lane
+        const auto at = Int32(index.raw);
+        Scatter(out.n, finished.raw, at, Int32(f.n.raw));
+        Scatter(out.r, finished.raw, at, PendingR<Var>(f).raw);
+        Scatter(out.ra, finished.raw, at, f.sa.raw);
+        Scatter(out.rb, finished.raw, at, f.sb.raw);
+        Scatter(out.de, finished.raw, at, f.da.raw);
+        Scatter(out.trap, finished.raw, at, f.trap.raw);
         return;
     }
 #endif
