@@ -30,6 +30,11 @@
 
 #include "dqjulia/batch.hpp"
 
+// This pass of the file compiles for AVX-512 (mask registers, compress, scatter): the raw
+// intrinsics below are used only then. Redefined, identically, on every pass.
+#undef DQJ_AVX512
+#define DQJ_AVX512 (HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL)
+
 HWY_BEFORE_NAMESPACE();
 namespace dqj {
 namespace HWY_NAMESPACE {
@@ -191,11 +196,7 @@ HWY_INLINE Orbit<hn::Vec<D>> StartOrbit(D d, const T* const* in, std::size_t at)
 /// it faster: dual, and paper-coupled in float. Paper's orbit carries two vectors more (db and
 /// |b|^2), two of them spill out of the 32 registers; paper-coupled in double lost 10 % on the
 /// bench's points (bench/README.md, "Stopped orbits").
-#if HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL
-constexpr bool kMaskRegisters = true;
-#else
-constexpr bool kMaskRegisters = false;
-#endif
+constexpr bool kMaskRegisters = DQJ_AVX512;
 template <Variant Var, typename T>
 constexpr bool kOrbitStops = kMaskRegisters &&
                              (Var == Variant::Dual || (Var == Variant::PaperCoupled && sizeof(T) == 4));
@@ -205,7 +206,7 @@ constexpr int kStepped = kOrbitStops<Var, T> ? 2 : 1;
 
 /// `updated` in the lanes still running, `old` in the others when the orbit stops (kOrbitStops).
 template <Variant Var, class M, class V>
-HWY_INLINE V Step(M running, V updated, V old) {
+HWY_INLINE V IfRunning(M running, V updated, V old) {
     if constexpr (kOrbitStops<Var, hn::TFromV<V>>) {
         return hn::IfThenElse(running, updated, old);
     } else {
@@ -213,9 +214,9 @@ HWY_INLINE V Step(M running, V updated, V old) {
     }
 }
 template <Variant Var, class M, class V>
-HWY_INLINE QuatV<V> Step(M running, const QuatV<V>& updated, const QuatV<V>& old) {
-    return {Step<Var>(running, updated.s, old.s), Step<Var>(running, updated.i, old.i),
-            Step<Var>(running, updated.j, old.j), Step<Var>(running, updated.k, old.k)};
+HWY_INLINE QuatV<V> IfRunning(M running, const QuatV<V>& updated, const QuatV<V>& old) {
+    return {IfRunning<Var>(running, updated.s, old.s), IfRunning<Var>(running, updated.i, old.i),
+            IfRunning<Var>(running, updated.j, old.j), IfRunning<Var>(running, updated.k, old.k)};
 }
 
 /// The fractal's constants as vectors.
@@ -235,19 +236,19 @@ HWY_INLINE void Step(D d, const ConstantsV<hn::Vec<D>>& c, int k, Orbit<hn::Vec<
     // Norms, the 8-D sum and the trap need no mask: from a stopped orbit they come out unchanged
     // (the same operations on the same values; trap <= |a|^2 already).
     if constexpr (Var == Variant::Paper) {
-        o.da = Step<Var>(running, hn::Mul(o.da, hn::Mul(c.four, o.sa)), o.da);
-        o.db = Step<Var>(running, hn::Mul(o.db, hn::Mul(c.four, o.sb)), o.db);
-        o.a = Step<Var>(running, SquarePlus(d, o.a, c.ca), o.a);
-        o.b = Step<Var>(running, SquarePlus(d, o.b, c.cb), o.b);
+        o.da = IfRunning<Var>(running, hn::Mul(o.da, hn::Mul(c.four, o.sa)), o.da);
+        o.db = IfRunning<Var>(running, hn::Mul(o.db, hn::Mul(c.four, o.sb)), o.db);
+        o.a = IfRunning<Var>(running, SquarePlus(d, o.a, c.ca), o.a);
+        o.b = IfRunning<Var>(running, SquarePlus(d, o.b, c.cb), o.b);
     } else if constexpr (Var == Variant::PaperCoupled) {
-        o.da = Step<Var>(running, hn::Mul(o.da, hn::Mul(c.four, o.s8)), o.da);
-        o.a = Step<Var>(running, SquarePlus(d, o.a, c.ca), o.a);
-        o.b = Step<Var>(running, SquarePlus(d, o.b, c.cb), o.b);
+        o.da = IfRunning<Var>(running, hn::Mul(o.da, hn::Mul(c.four, o.s8)), o.da);
+        o.a = IfRunning<Var>(running, SquarePlus(d, o.a, c.ca), o.a);
+        o.b = IfRunning<Var>(running, SquarePlus(d, o.b, c.cb), o.b);
     } else {
-        o.da = Step<Var>(running, hn::Mul(o.da, hn::Mul(c.four, o.sa)), o.da);
+        o.da = IfRunning<Var>(running, hn::Mul(o.da, hn::Mul(c.four, o.sa)), o.da);
         const QuatV<V> previous = o.a;  // b must use the old a
-        o.a = Step<Var>(running, SquarePlus(d, o.a, c.ca), o.a);
-        o.b = Step<Var>(running, SymmetricPlus(d, previous, o.b, c.cb), o.b);
+        o.a = IfRunning<Var>(running, SquarePlus(d, o.a, c.ca), o.a);
+        o.b = IfRunning<Var>(running, SymmetricPlus(d, previous, o.b, c.cb), o.b);
     }
     o.sa = SquaredNorm(o.a);
     if constexpr (Var != Variant::Dual) o.sb = SquaredNorm(o.b);  // dual: only needed at exit
@@ -360,7 +361,7 @@ HWY_INLINE Orbit<hn::Vec<D>> LoadOrbit(D d, const OrbitStore<T>& store, std::siz
 /// goes through a lookup table instead of vcompresspd.
 template <class D, typename T = hn::TFromD<D>>
 HWY_INLINE void PackStore(D d, hn::Vec<D> v, hn::Mask<D> mask, T* to) {
-#if HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL
+#if DQJ_AVX512
     if constexpr (sizeof(T) == 8 && hn::MaxLanes(d) == 8) {
         hn::StoreU(hn::Vec<D>{_mm512_maskz_compress_pd(mask.raw, v.raw)}, d, to);
     } else {
@@ -416,7 +417,7 @@ HWY_INLINE void WriteAll(D d, const Frozen<hn::Vec<D>>& f, const EscapeBatch<T>&
     hn::StoreU(f.trap, d, out.trap + at);
 }
 
-#if HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL
+#if DQJ_AVX512
 // AVX-512's masked scatters by element type: base[at[i]] = v[i] in the lanes of m.
 HWY_INLINE __m512i Int32(__m512 v) { return _mm512_cvttps_epi32(v); }
 HWY_INLINE __m256i Int32(__m512d v) { return _mm512_cvttpd_epi32(v); }
@@ -438,7 +439,7 @@ HWY_INLINE void Scatter(double* base, __mmask8 m, __m256i at, __m512d v) {
 template <Variant Var, class D, typename T = hn::TFromD<D>>
 HWY_INLINE void WriteFinished(D d, const Frozen<hn::Vec<D>>& f, hn::Mask<D> finished, hn::Vec<D> index,
                               const EscapeBatch<T>& out) {
-#if HWY_TARGET == HWY_AVX3 || HWY_TARGET == HWY_AVX3_DL
+#if DQJ_AVX512
     if constexpr (hn::MaxLanes(d) * sizeof(T) == 64) {  // masked scatters: no branch a lane
         const auto at = Int32(index.raw);
         Scatter(out.n, finished.raw, at, Int32(f.n.raw));
