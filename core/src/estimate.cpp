@@ -121,13 +121,14 @@ glm::dvec3 realPartGradient(const Fractal& fractal, const Quat& start, const Qua
     Quat a = start;
     Quat b[3] = {directions[0], directions[1], directions[2]};
     const double escapeAbove = squaredBailout<double>(fractal.bailout);
+    double normSquared = dot4(a, a);
     for (int k = 1; k <= fractal.iterations; ++k) {
         const Quat previous = a;
         a = square(a) + fractal.c.a;
         for (Quat& tangent : b) tangent = symmetricProduct(previous, tangent);  // c_b = 0
-        if (dot4(a, a) > escapeAbove) break;
+        normSquared = dot4(a, a);
+        if (normSquared > escapeAbove) break;
     }
-    const double normSquared = dot4(a, a);
     if (normSquared == 0.0) return glm::dvec3(0.0);
     return glm::dvec3(dot4(a, b[0]), dot4(a, b[1]), dot4(a, b[2])) / normSquared;
 }
