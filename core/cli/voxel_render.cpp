@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include <glm/geometric.hpp>
 #include <openvdb/openvdb.h>
@@ -46,7 +47,7 @@ VoxelHit traverse(const openvdb::FloatGrid& grid, const openvdb::CoordBBox& box,
     const glm::dvec3 d(ahead.x() - origin.x(), ahead.y() - origin.y(), ahead.z() - origin.z());
     const glm::dvec3 low(box.min().x(), box.min().y(), box.min().z());
     const glm::dvec3 high(box.max().x() + 1, box.max().y() + 1, box.max().z() + 1);
-    // Slab test against the active box.
+    // Slab test against the box.
     double tEnter = 0.0, tExit = std::numeric_limits<double>::infinity();
     int enterAxis = -1;
     for (int axis = 0; axis < 3; ++axis) {
@@ -63,25 +64,57 @@ VoxelHit traverse(const openvdb::FloatGrid& grid, const openvdb::CoordBBox& box,
         tExit = std::min(tExit, t1);
     }
     if (tEnter >= tExit) return {};
-    const glm::dvec3 start = o + d * (tEnter + 1e-9);
-    glm::ivec3 cell(std::floor(start.x), std::floor(start.y), std::floor(start.z));
-    glm::ivec3 step;
+    // Amanatides-Woo voxel stepping from parameter `from` on; restarted past empty tiles.
+    glm::ivec3 cell, step;
     glm::dvec3 next, delta;
-    for (int axis = 0; axis < 3; ++axis) {
-        step[axis] = d[axis] > 0 ? 1 : -1;
-        delta[axis] = d[axis] != 0.0 ? std::abs(1.0 / d[axis]) : std::numeric_limits<double>::infinity();
-        const double boundary = d[axis] > 0 ? cell[axis] + 1.0 : cell[axis];
-        next[axis] =
-            d[axis] != 0.0 ? tEnter + (boundary - start[axis]) / d[axis] : std::numeric_limits<double>::infinity();
-    }
+    auto enterAt = [&](double from) {
+        const glm::dvec3 start = o + d * (from + 1e-9);
+        cell = glm::ivec3(std::floor(start.x), std::floor(start.y), std::floor(start.z));
+        for (int a = 0; a < 3; ++a) {
+            step[a] = d[a] > 0 ? 1 : -1;
+            delta[a] = d[a] != 0.0 ? std::abs(1.0 / d[a]) : std::numeric_limits<double>::infinity();
+            const double boundary = d[a] > 0 ? cell[a] + 1.0 : cell[a];
+            next[a] = d[a] != 0.0 ? from + (boundary - start[a]) / d[a] : std::numeric_limits<double>::infinity();
+        }
+    };
+    enterAt(tEnter);
+    // Edge of the region a value of each tree depth stands for (getValueDepth: -1 background,
+    // 0 a root tile, 1 and 2 internal tiles, 3 a voxel): an empty tile is crossed in one step,
+    // not voxel by voxel, so a file whose few voxels lie far apart cannot stall the render.
+    using Root = openvdb::FloatTree::RootNodeType;
+    using Upper = Root::ChildNodeType;
+    using Lower = Upper::ChildNodeType;
+    constexpr int kRegion[] = {int(Upper::DIM), int(Upper::DIM), int(Lower::DIM), int(Lower::ChildNodeType::DIM), 1};
     auto accessor = grid.getConstAccessor();
     double t = tEnter;
     int axis = enterAxis;
     while (t <= tExit) {
-        if (accessor.getValue(openvdb::Coord(cell.x, cell.y, cell.z)) >= 0.5f) {
+        const openvdb::Coord xyz(cell.x, cell.y, cell.z);
+        if (accessor.getValue(xyz) >= 0.5f) {
             VoxelHit result{true, t, glm::dvec3(0.0)};
             if (axis >= 0) result.normal[axis] = -step[axis];
             return result;
+        }
+        const int size = kRegion[accessor.getValueDepth(xyz) + 1];
+        if (size > 1) {  // an empty tile: on to where the ray leaves it
+            double leave = std::numeric_limits<double>::infinity();
+            int leaveAxis = axis;
+            for (int a = 0; a < 3; ++a) {
+                if (d[a] == 0.0) continue;
+                const int low = cell[a] & ~(size - 1);  // tiles are aligned to their size
+                const double boundary = d[a] > 0 ? low + size : low;
+                const double at = (boundary - o[a]) / d[a];
+                if (at < leave) {
+                    leave = at;
+                    leaveAxis = a;
+                }
+            }
+            if (leave > t && leave < std::numeric_limits<double>::infinity()) {
+                t = leave;
+                axis = leaveAxis;
+                enterAt(t);
+                continue;
+            }
         }
         axis = next.x < next.y ? (next.x < next.z ? 0 : 2) : (next.y < next.z ? 1 : 2);
         t = next[axis];
@@ -97,8 +130,29 @@ RenderResult renderVoxels(const Params& params, const std::string& vdbPath, cons
     validate(params);
     const auto started = std::chrono::steady_clock::now();
     const openvdb::FloatGrid::ConstPtr grid = readDensity(vdbPath);
+    // The root's entries that can hold a solid voxel (a child, or a tile of density >= 0.5),
+    // each within the active box: a ray is traversed only through them, so a file whose few
+    // voxels or tiles lie far apart cannot stall the render (the empty space between them is
+    // never stepped through).
     const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
+    std::vector<openvdb::CoordBBox> regions;
+    const auto& root = grid->tree().root();
+    for (auto child = root.cbeginChildOn(); child; ++child) regions.push_back(child->getNodeBoundingBox());
+    for (auto tile = root.cbeginValueAll(); tile; ++tile)
+        if (*tile >= 0.5f)
+            regions.push_back(
+                openvdb::CoordBBox::createCube(tile.getCoord(), openvdb::FloatTree::RootNodeType::ChildNodeType::DIM));
+    for (openvdb::CoordBBox& region : regions) region.intersect(box);
+    std::erase_if(regions, [](const openvdb::CoordBBox& region) { return region.empty(); });
     const CameraFrame camera = frameCamera(params, renderBounds(params));
+    auto firstHit = [&](const glm::dvec3& direction) {
+        VoxelHit first;
+        for (const openvdb::CoordBBox& region : regions) {
+            const VoxelHit hit = traverse(*grid, region, camera.eye, direction);
+            if (hit.hit && (!first.hit || hit.t < first.t)) first = hit;
+        }
+        return first;
+    };
     const RenderSettings& settings = params.render;
     const Material& material = params.material;
 
@@ -124,7 +178,7 @@ RenderResult renderVoxels(const Params& params, const std::string& vdbPath, cons
                     for (int sx = 0; sx < samples; ++sx) {
                         const glm::dvec3 direction =
                             camera.rayDirection(x + (sx + 0.5) / samples, y + (sy + 0.5) / samples);
-                        const VoxelHit hit = box.empty() ? VoxelHit{} : traverse(*grid, box, camera.eye, direction);
+                        const VoxelHit hit = firstHit(direction);
                         if (!hit.hit) {
                             // The same vertical gradient as render()'s background.
                             const double height = glm::dot(direction, camera.up) / glm::dot(direction, camera.forward) /
