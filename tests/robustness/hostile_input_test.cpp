@@ -136,18 +136,6 @@ TEST_F(Hostile, VdbFilesTheFuzzerFoundAreRefusedWithAShortReason) {
     EXPECT_GE(files, 1u);
 }
 
-// A valid file (the fuzzer found it: fuzz.vdb timed out) whose density tiles, all below the
-// solid threshold, span 2e9 voxels: the voxel render stepped through the empty space between
-// them ray by ray and never finished. Now a ray visits only the root's entries that can hold a
-// solid voxel: the picture is empty, written, and says so.
-TEST_F(Hostile, VdbWithFarApartTilesRendersEmptyWithoutStalling) {
-    const auto result = run("render -q -W 32 -H 24 --voxels '" + std::string(DQJ_TEST_DATA) +
-                            "/far-apart-tiles.vdb' -o " + path("voxels.png"));
-    EXPECT_EQ(result.exitCode, 0) << result.err;
-    EXPECT_CONTAINS(result.err, "shows no surface");
-    EXPECT_TRUE(fs::exists(dir_ / "voxels.png"));
-}
-
 // --- The JSON path: nesting, size, duplicates, NUL bytes ---------------------------------
 
 TEST_F(Hostile, DeepNestingIsRefusedNotAStackOverflow) {
