@@ -5,6 +5,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -45,8 +46,9 @@ VoxelHit traverse(const openvdb::FloatGrid& grid, const openvdb::CoordBBox& box,
     // Shift by half a voxel so voxel (i, j, k) covers [i, i + 1); t stays in world units.
     const glm::dvec3 o(origin.x() + 0.5, origin.y() + 0.5, origin.z() + 0.5);
     const glm::dvec3 d(ahead.x() - origin.x(), ahead.y() - origin.y(), ahead.z() - origin.z());
+    // In double and 64-bit integers from here: a box may end at the largest Int32.
     const glm::dvec3 low(box.min().x(), box.min().y(), box.min().z());
-    const glm::dvec3 high(box.max().x() + 1, box.max().y() + 1, box.max().z() + 1);
+    const glm::dvec3 high(box.max().x() + 1.0, box.max().y() + 1.0, box.max().z() + 1.0);
     // Slab test against the box.
     double tEnter = 0.0, tExit = std::numeric_limits<double>::infinity();
     int enterAxis = -1;
@@ -65,11 +67,11 @@ VoxelHit traverse(const openvdb::FloatGrid& grid, const openvdb::CoordBBox& box,
     }
     if (tEnter >= tExit) return {};
     // Amanatides-Woo voxel stepping from parameter `from` on; restarted past empty tiles.
-    glm::ivec3 cell, step;
+    glm::i64vec3 cell, step;
     glm::dvec3 next, delta;
     auto enterAt = [&](double from) {
         const glm::dvec3 start = o + d * (from + 1e-9);
-        cell = glm::ivec3(std::floor(start.x), std::floor(start.y), std::floor(start.z));
+        cell = glm::i64vec3(std::floor(start.x), std::floor(start.y), std::floor(start.z));
         for (int a = 0; a < 3; ++a) {
             step[a] = d[a] > 0 ? 1 : -1;
             delta[a] = d[a] != 0.0 ? std::abs(1.0 / d[a]) : std::numeric_limits<double>::infinity();
@@ -89,7 +91,7 @@ VoxelHit traverse(const openvdb::FloatGrid& grid, const openvdb::CoordBBox& box,
     double t = tEnter;
     int axis = enterAxis;
     while (t <= tExit) {
-        const openvdb::Coord xyz(cell.x, cell.y, cell.z);
+        const openvdb::Coord xyz(openvdb::Int32(cell.x), openvdb::Int32(cell.y), openvdb::Int32(cell.z));
         if (accessor.getValue(xyz) >= 0.5f) {
             VoxelHit result{true, t, glm::dvec3(0.0)};
             if (axis >= 0) result.normal[axis] = -step[axis];
@@ -101,8 +103,8 @@ VoxelHit traverse(const openvdb::FloatGrid& grid, const openvdb::CoordBBox& box,
             int leaveAxis = axis;
             for (int a = 0; a < 3; ++a) {
                 if (d[a] == 0.0) continue;
-                const int low = cell[a] & ~(size - 1);  // tiles are aligned to their size
-                const double boundary = d[a] > 0 ? low + size : low;
+                const std::int64_t low = cell[a] & ~std::int64_t(size - 1);  // tiles are aligned to their size
+                const double boundary = double(d[a] > 0 ? low + size : low);
                 const double at = (boundary - o[a]) / d[a];
                 if (at < leave) {
                     leave = at;
