@@ -5,7 +5,8 @@
 #
 #   zlib 1.2.13, libpng 1.6.39, Imath 3.1.6, OpenEXR 3.1.5, oneTBB 2021.8.0,
 #   Highway 1.0.3, LZ4 1.9.4, c-blosc 1.21.3, OpenVDB 10.0.1 (with Blosc; no delayed loading:
-#   no Boost libraries; scripts/patches/ adds bounds checks to its chunk readers)
+#   no Boost libraries; scripts/patches/ makes its readers safe for damaged files: bounds
+#   checks in its chunk readers, bools read from a file made valid, node origins checked)
 #
 # Debian's c-blosc source ("1.21.3+ds") has its bundled codecs stripped: it is built against
 # our LZ4 (Debian's lz4 source; the codec OpenVDB's Blosc compression uses) and zlib, without
@@ -46,10 +47,10 @@ done
 here=$(cd "$(dirname "$0")" && pwd)
 versions="zlib-1.2.13_png-1.6.39_imath-3.1.6_exr-3.1.5_tbb-2021.8.0_hwy-1.0.3_lz4-1.9.4_blosc-1.21.3_vdb-10.0.1"
 case "$target" in
-  linux-x64) recipe=4 ;;  # bump when the build options or patches below change
+  linux-x64) recipe=5 ;;  # bump when the build options or patches below change
   windows-x64)
     versions="${versions}_ft-2.12.1_gtest-1.12.1_glm-0.9.9.8_json-3.11.2_cli11-2.1.2"
-    recipe=7 ;;
+    recipe=8 ;;
   *) echo "dqjulia deps: unknown target '$target' (linux-x64 or windows-x64)" >&2; exit 2 ;;
 esac
 key="${versions}_r${recipe}"
@@ -121,9 +122,11 @@ fetch highway 'highway_1.0.3.orig.tar.*'
 fetch lz4 'lz4_1.9.4.orig.tar.*'
 fetch c-blosc 'c-blosc_1.21.3*.orig.tar.*'
 fetch openvdb 'openvdb_10.0.1.orig.tar.*'
-# Bounds checks for damaged files in OpenVDB's chunk readers (the patch says what and why).
-patch -d "$work/src/openvdb" -p1 --quiet < "$here/patches/openvdb-10.0.1-compression-bounds.patch" \
-  || { echo "dqjulia deps: patching OpenVDB failed" >&2; exit 1; }
+# OpenVDB's readers made safe for damaged files (each patch says what and why).
+for fix in compression-bounds read-bools node-origins; do
+  patch -d "$work/src/openvdb" -p1 --quiet < "$here/patches/openvdb-10.0.1-$fix.patch" \
+    || { echo "dqjulia deps: patching OpenVDB ($fix) failed" >&2; exit 1; }
+done
 if [ "$target" = windows-x64 ]; then
   fetch freetype 'freetype_2.12.1*.orig.tar.*'
   fetch googletest 'googletest_1.12.1.orig.tar.*'

@@ -170,3 +170,21 @@ TEST_F(VdbFiles, ZipAndUncompressedTilesStillMerge) {
     for (const openvdb::GridBase::Ptr& grid : *mixed.grids)
         EXPECT_EQ(compressionOf(*grid), "blosc + active values") << grid->getName();
 }
+
+// OpenVDB reads bools straight from a file's bytes; a byte other than 0 or 1 must read as true
+// (a bool holding 7 is undefined behaviour, and may compare unequal to true). The file
+// (tests/robustness/make_vdb_seeds.py) holds a bool grid's root tile stored as value 7,
+// active 9, and the file metadata `flagged` stored as 2.
+TEST_F(VdbFiles, BoolsStoredAsOtherBytesReadAsTrue) {
+    const VdbContents contents = readVdbFile(std::string(DQJ_VDB_CORPUS) + "/bool-bytes.vdb");
+    const auto flags = openvdb::gridPtrCast<openvdb::BoolGrid>(findGrid(contents, "flags"));
+    ASSERT_TRUE(flags);
+    bool value = false;
+    EXPECT_TRUE(flags->tree().probeValue(openvdb::Coord(12288 + 100, 20480, 28672 + 4095), value));  // active
+    EXPECT_EQ(value, true);
+    EXPECT_EQ(flags->tree().activeTileCount(), 1u);
+    EXPECT_EQ(contents.metadata->metaValue<bool>("flagged"), true);
+    const auto density = openvdb::gridPtrCast<openvdb::FloatGrid>(findGrid(contents, "density"));
+    ASSERT_TRUE(density);
+    EXPECT_EQ(density->activeVoxelCount(), 16u * 16u * 16u);
+}

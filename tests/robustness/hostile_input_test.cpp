@@ -136,6 +136,42 @@ TEST_F(Hostile, VdbFilesTheFuzzerFoundAreRefusedWithAShortReason) {
     EXPECT_GE(files, 1u);
 }
 
+// A file whose density tiles, all below the solid threshold, lie at the far corners of the
+// index space (make_vdb_seeds.py; the fuzzer found the first such file: fuzz.vdb timed out): the
+// voxel render stepped through the 4e9 voxels between them ray by ray and never finished. Now a
+// ray visits only the root's entries that can hold a solid voxel: the picture is empty, written,
+// and says so.
+TEST_F(Hostile, VdbWithFarApartTilesRendersEmptyWithoutStalling) {
+    const auto result = run("render -q -W 32 -H 24 --voxels '" + std::string(DQJ_VDB_CORPUS) +
+                            "/far-apart-tiles.vdb' -o " + path("voxels.png"));
+    EXPECT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_CONTAINS(result.err, "shows no surface");
+    EXPECT_TRUE(fs::exists(dir_ / "voxels.png"));
+}
+
+// A file whose bools are bytes other than 0 and 1 (a bool grid's tile, the file's metadata;
+// make_vdb_seeds.py) reads as if they were 1: the density cube beside them renders.
+TEST_F(Hostile, BoolsStoredAsOtherBytesReadAsTrue) {
+    const auto result = run("render -q -W 32 -H 24 --voxels '" + std::string(DQJ_VDB_CORPUS) + "/bool-bytes.vdb' -o " +
+                            path("voxels.png"));
+    EXPECT_EQ(result.exitCode, 0) << result.err;
+    EXPECT_EQ(result.err.find("shows no surface"), std::string::npos) << result.err;
+    EXPECT_TRUE(fs::exists(dir_ / "voxels.png"));
+}
+
+// The same 8^3 cube at the far corner of the index space (its last voxel at the largest Int32
+// on every axis) and at the origin, each placed at the world's origin by its transform: the
+// ray's index arithmetic passed the largest Int32 at the corner, and the render never ended.
+TEST_F(Hostile, ACubeAtTheCornerOfTheIndexSpaceRendersAsAtTheOrigin) {
+    for (const char* name : {"corner", "origin"}) {
+        const auto result = run("render -q -W 64 -H 48 --voxels '" + std::string(DQJ_VDB_CORPUS) + "/" + name +
+                                "-cube.vdb' -o " + path(std::string(name) + ".png"));
+        EXPECT_EQ(result.exitCode, 0) << name << ": " << result.err;
+        EXPECT_EQ(result.err.find("shows no surface"), std::string::npos) << name << ": " << result.err;
+    }
+    EXPECT_EQ(readFile(dir_ / "corner.png"), readFile(dir_ / "origin.png"));
+}
+
 // --- The JSON path: nesting, size, duplicates, NUL bytes ---------------------------------
 
 TEST_F(Hostile, DeepNestingIsRefusedNotAStackOverflow) {
