@@ -19,7 +19,7 @@
 namespace {
 constexpr std::size_t kLargestAllocation = std::size_t(1) << 31;
 void* allocate(std::size_t size) {
-    if (size > kLargestAllocation) throw std::bad_alloc();
+    if (size >= kLargestAllocation) throw std::bad_alloc();  // libFuzzer stops at 2 GB itself
     if (void* memory = std::malloc(size ? size : 1)) return memory;
     throw std::bad_alloc();
 }
@@ -31,7 +31,7 @@ void operator delete[](void* memory) noexcept { std::free(memory); }
 void operator delete(void* memory, std::size_t) noexcept { std::free(memory); }
 void operator delete[](void* memory, std::size_t) noexcept { std::free(memory); }
 void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
-    return size > kLargestAllocation ? nullptr : std::malloc(size ? size : 1);
+    return size >= kLargestAllocation ? nullptr : std::malloc(size ? size : 1);
 }
 void* operator new[](std::size_t size, const std::nothrow_t& tag) noexcept { return operator new(size, tag); }
 void operator delete(void* memory, const std::nothrow_t&) noexcept { std::free(memory); }
