@@ -66,15 +66,18 @@ VoxelHit traverse(const openvdb::FloatGrid& grid, const openvdb::CoordBBox& box,
         tExit = std::min(tExit, t1);
     }
     if (tEnter >= tExit) return {};
-    // Amanatides-Woo voxel stepping from parameter `from` on; restarted past empty tiles.
+    // Amanatides-Woo voxel stepping from parameter `from` on; restarted past empty tiles (the
+    // steps and the distances between boundaries are the ray's own, set once).
     glm::i64vec3 cell, step;
     glm::dvec3 next, delta;
+    for (int a = 0; a < 3; ++a) {
+        step[a] = d[a] > 0 ? 1 : -1;
+        delta[a] = d[a] != 0.0 ? std::abs(1.0 / d[a]) : std::numeric_limits<double>::infinity();
+    }
     auto enterAt = [&](double from) {
         const glm::dvec3 start = o + d * (from + 1e-9);
         cell = glm::i64vec3(std::floor(start.x), std::floor(start.y), std::floor(start.z));
         for (int a = 0; a < 3; ++a) {
-            step[a] = d[a] > 0 ? 1 : -1;
-            delta[a] = d[a] != 0.0 ? std::abs(1.0 / d[a]) : std::numeric_limits<double>::infinity();
             const double boundary = d[a] > 0 ? cell[a] + 1.0 : cell[a];
             next[a] = d[a] != 0.0 ? from + (boundary - start[a]) / d[a] : std::numeric_limits<double>::infinity();
         }
