@@ -6,7 +6,8 @@
 #   zlib 1.2.13, libpng 1.6.39, Imath 3.1.6, OpenEXR 3.1.5, oneTBB 2021.8.0,
 #   Highway 1.0.3, LZ4 1.9.4, c-blosc 1.21.3, OpenVDB 10.0.1 (with Blosc; no delayed loading:
 #   no Boost libraries; scripts/patches/ makes its readers safe for damaged files: bounds
-#   checks in its chunk readers, bools read from a file made valid, node origins checked)
+#   checks in its chunk readers, bools read from a file made valid, node origins checked,
+#   nothing leaked when a read fails)
 #
 # Debian's c-blosc source ("1.21.3+ds") has its bundled codecs stripped: it is built against
 # our LZ4 (Debian's lz4 source; the codec OpenVDB's Blosc compression uses) and zlib, without
@@ -47,10 +48,10 @@ done
 here=$(cd "$(dirname "$0")" && pwd)
 versions="zlib-1.2.13_png-1.6.39_imath-3.1.6_exr-3.1.5_tbb-2021.8.0_hwy-1.0.3_lz4-1.9.4_blosc-1.21.3_vdb-10.0.1"
 case "$target" in
-  linux-x64) recipe=5 ;;  # bump when the build options or patches below change
+  linux-x64) recipe=6 ;;  # bump when the build options or patches below change
   windows-x64)
     versions="${versions}_ft-2.12.1_gtest-1.12.1_glm-0.9.9.8_json-3.11.2_cli11-2.1.2"
-    recipe=8 ;;
+    recipe=9 ;;
   *) echo "dqjulia deps: unknown target '$target' (linux-x64 or windows-x64)" >&2; exit 2 ;;
 esac
 key="${versions}_r${recipe}"
@@ -123,7 +124,7 @@ fetch lz4 'lz4_1.9.4.orig.tar.*'
 fetch c-blosc 'c-blosc_1.21.3*.orig.tar.*'
 fetch openvdb 'openvdb_10.0.1.orig.tar.*'
 # OpenVDB's readers made safe for damaged files (each patch says what and why).
-for fix in compression-bounds read-bools node-origins; do
+for fix in compression-bounds read-bools node-origins read-failures; do
   patch -d "$work/src/openvdb" -p1 --quiet < "$here/patches/openvdb-10.0.1-$fix.patch" \
     || { echo "dqjulia deps: patching OpenVDB ($fix) failed" >&2; exit 1; }
 done
