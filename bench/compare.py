@@ -433,7 +433,7 @@ def compare(args, dqjulia, work):
                 target = resolution == 512
                 rows.append((f"mesh {resolution}^3 wall s", f"{times['dqjulia']['wall']:.2f}",
                              f"Mandelbulber {times['mandelbulber2']['wall']:.2f}", f"{ratio:.1f}x faster",
-                             ">= 10x" if target else "", ratio >= 10.0 if target else None))
+                             ">= 50x" if target else "", ratio >= 50.0 if target else None))
                 rows.append((f"mesh {resolution}^3 peak MB", f"{times['dqjulia']['peak_kb'] / 1024:.0f}",
                              f"Mandelbulber {times['mandelbulber2']['peak_kb'] / 1024:.0f}", f"{memory:.2f}x less",
                              "less" if target else "", memory > 1.0 if target else None))

@@ -3,6 +3,7 @@
 #include "dqjulia/version.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cerrno>
 #include <chrono>
@@ -10,6 +11,7 @@
 #include <cstring>
 #include <fstream>
 #include <sstream>
+#include <type_traits>
 
 #include <glm/geometric.hpp>
 #include <openvdb/tools/VolumeToMesh.h>
@@ -120,35 +122,38 @@ void writePly(const Mesh& mesh, std::ostream& out) {
     if (colors) out << "property uchar red\nproperty uchar green\nproperty uchar blue\n";
     out << "element face " << mesh.triangles.size() + mesh.quads.size() << "\n"
         << "property list uchar uint vertex_indices\nend_header\n";
-    // The body goes through a buffer written out a megabyte at a time.
-    std::vector<char> buffer;
-    auto put = [&](const void* data, std::size_t size) {
-        const char* bytes = static_cast<const char*>(data);
-        buffer.insert(buffer.end(), bytes, bytes + size);
-        if (buffer.size() >= (1u << 20)) {
-            out.write(buffer.data(), std::streamsize(buffer.size()));
-            buffer.clear();
+    // The body is fixed-size records: each goes into place in a block of about a megabyte,
+    // written out a block at a time.
+    std::vector<char> block(1u << 20);
+    auto records = [&](std::size_t count, std::size_t size, auto encode) {
+        const std::size_t perBlock = block.size() / size;
+        for (std::size_t first = 0; first < count; first += perBlock) {
+            const std::size_t end = std::min(count, first + perBlock);
+            char* at = block.data();
+            for (std::size_t index = first; index < end; ++index, at += size) encode(index, at);
+            out.write(block.data(), std::streamsize(at - block.data()));
         }
     };
-    for (std::size_t index = 0; index < mesh.positions.size(); ++index) {
-        put(&mesh.positions[index], sizeof(glm::vec3));
-        put(&mesh.normals[index], sizeof(glm::vec3));
+    constexpr std::size_t kVec3 = sizeof(glm::vec3);
+    records(mesh.positions.size(), 2 * kVec3 + (colors ? 3 : 0), [&](std::size_t index, char* at) {
+        std::memcpy(at, &mesh.positions[index], kVec3);
+        std::memcpy(at + kVec3, &mesh.normals[index], kVec3);
         if (colors) {
-            const std::uint8_t rgb[3] = {linearToSrgb8(mesh.colors[index].x), linearToSrgb8(mesh.colors[index].y),
-                                         linearToSrgb8(mesh.colors[index].z)};
-            put(rgb, 3);
+            const glm::vec3& c = mesh.colors[index];
+            const std::uint8_t rgb[3] = {linearToSrgb8(c.x), linearToSrgb8(c.y), linearToSrgb8(c.z)};
+            std::memcpy(at + 2 * kVec3, rgb, 3);
         }
-    }
-    const std::uint8_t three = 3, four = 4;
-    for (const auto& triangle : mesh.triangles) {
-        put(&three, 1);
-        put(triangle.data(), 3 * sizeof(std::uint32_t));
-    }
-    for (const auto& quad : mesh.quads) {
-        put(&four, 1);
-        put(quad.data(), 4 * sizeof(std::uint32_t));
-    }
-    out.write(buffer.data(), std::streamsize(buffer.size()));
+    });
+    auto faces = [&](const auto& list) {
+        using Face = std::decay_t<decltype(list[0])>;
+        constexpr std::uint8_t corners = std::tuple_size_v<Face>;
+        records(list.size(), 1 + sizeof(Face), [&](std::size_t index, char* at) {
+            *at = static_cast<char>(corners);
+            std::memcpy(at + 1, list[index].data(), sizeof(Face));
+        });
+    };
+    faces(mesh.triangles);
+    faces(mesh.quads);
 }
 
 void writeObj(const Mesh& mesh, std::ostream& out) {
