@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cerrno>
 #include <chrono>
@@ -15,6 +16,8 @@
 
 #include <glm/geometric.hpp>
 #include <openvdb/tools/VolumeToMesh.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 
 #include "atomic_file.hpp"
 #include "dqjulia/batch.hpp"
@@ -52,10 +55,37 @@ int distinctCorners(const std::uint32_t* indices, int count, std::uint32_t* dist
     return size;
 }
 
+/// True if a face has a repeated vertex or a vertex belongs to no face; in parallel.
+bool hasDegenerateOrUnusedParts(const Mesh& mesh) {
+    std::atomic<bool> found{false};
+    std::vector<std::atomic<std::uint8_t>> used(mesh.positions.size());  // zeroed (C++20)
+    auto check = [&](const auto& faces) {
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, faces.size()), [&](const auto& range) {
+            std::uint32_t distinct[4];
+            for (std::size_t index = range.begin(); index < range.end(); ++index) {
+                const auto& face = faces[index];
+                const int corners = static_cast<int>(face.size());
+                if (distinctCorners(face.data(), corners, distinct) != corners)
+                    found.store(true, std::memory_order_relaxed);
+                for (const std::uint32_t vertex : face) used[vertex].store(1, std::memory_order_relaxed);
+            }
+        });
+    };
+    check(mesh.triangles);
+    check(mesh.quads);
+    if (found.load()) return true;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, used.size()), [&](const auto& range) {
+        for (std::size_t index = range.begin(); index < range.end(); ++index)
+            if (used[index].load(std::memory_order_relaxed) == 0) found.store(true, std::memory_order_relaxed);
+    });
+    return found.load();
+}
+
 /// Drops faces with fewer than three distinct vertices and turns quads with one repeated vertex
 /// into triangles (adaptive meshing collapses vertices), then drops unused vertices. In place:
 /// a 512^3 mesh is some 40 MB, and copies would add to the peak.
 void removeDegenerateFaces(Mesh& mesh) {
+    if (!hasDegenerateOrUnusedParts(mesh)) return;  // nothing would change (OpenVDB's uniform meshes)
     std::uint32_t distinct[4];
     std::size_t kept = 0;
     for (const auto& triangle : mesh.triangles)
@@ -224,30 +254,36 @@ Mesh bakeMesh(const Params& params, const BakeOptions& options, const ProgressCa
         releaseFreedMemory();
         const openvdb::Vec3s* points = mesher.pointList().get();
         mesh.positions.resize(mesher.pointListSize());
-        for (std::size_t index = 0; index < mesh.positions.size(); ++index)
-            mesh.positions[index] = glm::vec3(points[index].x(), points[index].y(), points[index].z());
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.positions.size()), [&](const auto& range) {
+            for (std::size_t index = range.begin(); index < range.end(); ++index)
+                mesh.positions[index] = glm::vec3(points[index].x(), points[index].y(), points[index].z());
+        });
         mesher.pointList().reset();
-        // Faces are counter-clockwise seen from the positive (outside) side.
-        std::size_t quadCount = 0, triangleCount = 0;
-        for (std::size_t pool = 0; pool < mesher.polygonPoolListSize(); ++pool) {
-            quadCount += mesher.polygonPoolList()[pool].numQuads();
-            triangleCount += mesher.polygonPoolList()[pool].numTriangles();
+        // Faces are counter-clockwise seen from the positive (outside) side. Each pool goes to
+        // its place in the face arrays (pool order, as one after another), then is freed.
+        const std::size_t pools = mesher.polygonPoolListSize();
+        std::vector<std::size_t> quadsBefore(pools + 1, 0), trianglesBefore(pools + 1, 0);
+        for (std::size_t pool = 0; pool < pools; ++pool) {
+            quadsBefore[pool + 1] = quadsBefore[pool] + mesher.polygonPoolList()[pool].numQuads();
+            trianglesBefore[pool + 1] = trianglesBefore[pool] + mesher.polygonPoolList()[pool].numTriangles();
         }
-        mesh.quads.reserve(quadCount);
-        mesh.triangles.reserve(triangleCount);
-        for (std::size_t pool = 0; pool < mesher.polygonPoolListSize(); ++pool) {
-            openvdb::tools::PolygonPool& polygons = mesher.polygonPoolList()[pool];
-            for (std::size_t index = 0; index < polygons.numQuads(); ++index) {
-                const openvdb::Vec4I& quad = polygons.quad(index);
-                mesh.quads.push_back({quad[0], quad[1], quad[2], quad[3]});
+        mesh.quads.resize(quadsBefore[pools]);
+        mesh.triangles.resize(trianglesBefore[pools]);
+        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pools), [&](const auto& range) {
+            for (std::size_t pool = range.begin(); pool < range.end(); ++pool) {
+                openvdb::tools::PolygonPool& polygons = mesher.polygonPoolList()[pool];
+                for (std::size_t index = 0; index < polygons.numQuads(); ++index) {
+                    const openvdb::Vec4I& quad = polygons.quad(index);
+                    mesh.quads[quadsBefore[pool] + index] = {quad[0], quad[1], quad[2], quad[3]};
+                }
+                for (std::size_t index = 0; index < polygons.numTriangles(); ++index) {
+                    const openvdb::Vec3I& triangle = polygons.triangle(index);
+                    mesh.triangles[trianglesBefore[pool] + index] = {triangle[0], triangle[1], triangle[2]};
+                }
+                polygons.clearQuads();
+                polygons.clearTriangles();
             }
-            for (std::size_t index = 0; index < polygons.numTriangles(); ++index) {
-                const openvdb::Vec3I& triangle = polygons.triangle(index);
-                mesh.triangles.push_back({triangle[0], triangle[1], triangle[2]});
-            }
-            polygons.clearQuads();
-            polygons.clearTriangles();
-        }
+        });
     });
     removeDegenerateFaces(mesh);
     mesh.normals = vertexNormals(mesh);
