@@ -55,25 +55,29 @@ int distinctCorners(const std::uint32_t* indices, int count, std::uint32_t* dist
     return size;
 }
 
-/// True if a face has a repeated vertex or a vertex belongs to no face; in parallel.
+/// True if a face has a repeated vertex or a vertex belongs to no face; in parallel, stopping
+/// at the first such face (adaptive meshes have some, and then removeDegenerateFaces does the
+/// full pass).
 bool hasDegenerateOrUnusedParts(const Mesh& mesh) {
     std::atomic<bool> found{false};
     std::vector<std::atomic<std::uint8_t>> used(mesh.positions.size());  // zeroed (C++20)
     auto check = [&](const auto& faces) {
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, faces.size()), [&](const auto& range) {
+            if (found.load(std::memory_order_relaxed)) return;
             std::uint32_t distinct[4];
             for (std::size_t index = range.begin(); index < range.end(); ++index) {
                 const auto& face = faces[index];
                 const int corners = static_cast<int>(face.size());
-                if (distinctCorners(face.data(), corners, distinct) != corners)
+                if (distinctCorners(face.data(), corners, distinct) != corners) {
                     found.store(true, std::memory_order_relaxed);
+                    return;
+                }
                 for (const std::uint32_t vertex : face) used[vertex].store(1, std::memory_order_relaxed);
             }
         });
+        return found.load();
     };
-    check(mesh.triangles);
-    check(mesh.quads);
-    if (found.load()) return true;
+    if (check(mesh.triangles) || check(mesh.quads)) return true;
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, used.size()), [&](const auto& range) {
         for (std::size_t index = range.begin(); index < range.end(); ++index)
             if (used[index].load(std::memory_order_relaxed) == 0) found.store(true, std::memory_order_relaxed);
