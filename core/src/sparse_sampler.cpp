@@ -5,6 +5,7 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -13,6 +14,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <glm/geometric.hpp>
+#include <glm/vector_relational.hpp>
 
 #include "dqjulia/ball_bound.hpp"
 #include "dqjulia/batch.hpp"
@@ -407,6 +409,15 @@ double BakeRegion::signedDistance(const glm::dvec3& p) const {
     return outside + inside;
 }
 
+bool BakeRegion::containsWithMargin(const glm::dvec3& lo, const glm::dvec3& hi, double margin) const {
+    if (sphere_) {  // the box's corner farthest from the centre
+        const glm::dvec3 far = glm::max(glm::abs(lo - bounds_.center), glm::abs(hi - bounds_.center));
+        return glm::length(far) <= bounds_.radius - margin;
+    }
+    return glm::all(glm::greaterThanEqual(lo, box_.min + margin)) &&
+           glm::all(glm::lessThanEqual(hi, box_.max - margin));
+}
+
 SurfaceFunction::SurfaceFunction(const Params& params, double voxelSize)
     : fractal_(params.fractal),
       slice_(params.slice.effective()),
@@ -448,11 +459,21 @@ void SurfaceFunction::operator()(const glm::dvec3* points, std::size_t count, fl
     distances.resize(count);
     std::array<double*, 8> coordinates;
     for (int k = 0; k < 8; ++k) coordinates[k] = batch.start(k);
+    // Where every point lies deeper inside the region than the band, its distance d <= -limit
+    // cannot change f: clamp(max(inner, d)) = clamp(inner) for any inner (NaN included), so d
+    // is taken as -limit without computing it. A voxel more margin covers the rounding of d.
+    const double limit = background_;
+    glm::dvec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+    for (std::size_t i = 0; i < count; ++i) {
+        lo = glm::min(lo, points[i]);
+        hi = glm::max(hi, points[i]);
+    }
+    const bool deep = count > 0 && region_.containsWithMargin(lo, hi, limit + voxelSize_);
     std::size_t inside = 0;
     for (std::size_t i = 0; i < count; ++i) {
-        const double regionDistance = region_.signedDistance(points[i]);
+        const double regionDistance = deep ? -limit : region_.signedDistance(points[i]);
         if (regionDistance > 0.0) {
-            values[i] = float(std::min(regionDistance, double(background_)));
+            values[i] = float(std::min(regionDistance, limit));
             continue;
         }
         const Vec8 z = toVec8(slice_.map(points[i]));

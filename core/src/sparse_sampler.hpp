@@ -35,6 +35,8 @@ public:
     /// Signed distance to the region's boundary: negative inside (exact for the sphere, the
     /// usual box distance for the box).
     double signedDistance(const glm::dvec3& p) const;
+    /// Does every point of the box [lo, hi] lie at least `margin` inside the region?
+    bool containsWithMargin(const glm::dvec3& lo, const glm::dvec3& hi, double margin) const;
     /// The region's bounding box.
     const Box& box() const { return box_; }
 
