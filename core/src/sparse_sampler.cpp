@@ -46,9 +46,10 @@ Coord leafKey(const Coord& origin) { return Coord(origin.x() >> 3, origin.y() >>
 
 glm::dvec3 voxelCentre(const Coord& ijk, double h) { return glm::dvec3(ijk.x(), ijk.y(), ijk.z()) * h; }
 
-/// Does the leaf have a voxel that is not inside (f >= 0) on its boundary towards the neighbour
-/// at offset (dx, dy, dz) (each -1, 0 or 1): a face, an edge or a corner?
-bool outsideTowards(const FloatLeaf& leaf, int dx, int dy, int dz) {
+/// Does the leaf have a voxel that is inside (f < 0, `inside` true) or not inside (f >= 0,
+/// `inside` false) on its boundary towards the neighbour at offset (dx, dy, dz) (each -1, 0 or
+/// 1): a face, an edge or a corner?
+bool anyOnBoundaryTowards(const FloatLeaf& leaf, int dx, int dy, int dz, bool inside) {
     auto range = [](int d, int& low, int& high) {
         low = d > 0 ? kLeafSize - 1 : 0;
         high = d < 0 ? 0 : kLeafSize - 1;
@@ -57,11 +58,22 @@ bool outsideTowards(const FloatLeaf& leaf, int dx, int dy, int dz) {
     range(dx, x0, x1);
     range(dy, y0, y1);
     range(dz, z0, z1);
+    const float* values = leaf.buffer().data();
     for (int x = x0; x <= x1; ++x)
         for (int y = y0; y <= y1; ++y)
             for (int z = z0; z <= z1; ++z)
-                if (!(leaf.getValue(FloatLeaf::coordToOffset(Coord(x, y, z))) < 0.0f)) return true;
+                if ((values[FloatLeaf::coordToOffset(Coord(x, y, z))] < 0.0f) == inside) return true;
     return false;
+}
+
+/// The 26 neighbour offsets.
+std::vector<Coord> neighbourOffsets() {
+    std::vector<Coord> offsets;
+    for (int dx = -1; dx <= 1; ++dx)
+        for (int dy = -1; dy <= 1; ++dy)
+            for (int dz = -1; dz <= 1; ++dz)
+                if (dx != 0 || dy != 0 || dz != 0) offsets.emplace_back(dx, dy, dz);
+    return offsets;
 }
 
 /// Replaces every leaf that no cell with a sign change touches by a tile of `background`. Mesh
@@ -75,23 +87,28 @@ std::size_t pruneAwayFromSurface(openvdb::FloatTree& tree, float background) {
     leaves.reserve(tree.leafCount());
     for (auto leaf = tree.cbeginLeaf(); leaf; ++leaf) leaves.push_back(leaf.getLeaf());
     std::vector<char> prunable(leaves.size(), 0);
+    const std::vector<Coord> offsets = neighbourOffsets();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, leaves.size()),
                       [&](const tbb::blocked_range<std::size_t>& range) {
                           openvdb::tree::ValueAccessor<const openvdb::FloatTree> accessor(tree);
                           for (std::size_t index = range.begin(); index != range.end(); ++index) {
                               const FloatLeaf& leaf = *leaves[index];
-                              bool inside = false;
-                              for (auto value = leaf.cbeginValueAll(); value && !inside; ++value)
-                                  inside = *value < 0.0f;
-                              const Coord low = leaf.origin().offsetBy(-1), high = leaf.origin().offsetBy(kLeafSize);
-                              // The shell's voxels only: all of a side column, the two ends of the others.
-                              for (int x = low.x(); x <= high.x() && !inside; ++x)
-                                  for (int y = low.y(); y <= high.y() && !inside; ++y) {
-                                      const bool side = x == low.x() || x == high.x() || y == low.y() || y == high.y();
-                                      const int step = side ? 1 : high.z() - low.z();
-                                      for (int z = low.z(); z <= high.z() && !inside; z += step)
-                                          inside = accessor.getValue(Coord(x, y, z)) < 0.0f;
-                                  }
+                              const float* values = leaf.buffer().data();
+                              bool inside = std::any_of(values, values + FloatLeaf::SIZE,
+                                                        [](float value) { return value < 0.0f; });
+                              // The one-voxel shell: each neighbour's boundary towards this leaf,
+                              // or its tile's value.
+                              for (std::size_t k = 0; k < offsets.size() && !inside; ++k) {
+                                  const Coord& offset = offsets[k];
+                                  const Coord origin =
+                                      leaf.origin().offsetBy(offset.x() * kLeafSize, offset.y() * kLeafSize,
+                                                             offset.z() * kLeafSize);
+                                  if (const FloatLeaf* neighbour = accessor.probeConstLeaf(origin))
+                                      inside =
+                                          anyOnBoundaryTowards(*neighbour, -offset.x(), -offset.y(), -offset.z(), true);
+                                  else
+                                      inside = accessor.getValue(origin) < 0.0f;
+                              }
                               prunable[index] = !inside;
                           }
                       });
@@ -100,16 +117,6 @@ std::size_t pruneAwayFromSurface(openvdb::FloatTree& tree, float background) {
         if (prunable[index]) origins.push_back(leaves[index]->origin());
     for (const Coord& origin : origins) tree.addTile(1, origin, background, false);
     return origins.size();
-}
-
-/// The 26 neighbour offsets.
-std::vector<Coord> neighbourOffsets() {
-    std::vector<Coord> offsets;
-    for (int dx = -1; dx <= 1; ++dx)
-        for (int dy = -1; dy <= 1; ++dy)
-            for (int dz = -1; dz <= 1; ++dz)
-                if (dx != 0 || dy != 0 || dz != 0) offsets.emplace_back(dx, dy, dz);
-    return offsets;
 }
 
 double largestStretch(Slice slice, bool keepReal, bool keepDual) {
@@ -176,7 +183,7 @@ public:
                 for (const Coord& offset : offsets) {
                     const Coord neighbour = key + offset;
                     if (states_.getValue(neighbour) != kDeferred) continue;
-                    if (!outsideTowards(*leaf, offset.x(), offset.y(), offset.z())) continue;
+                    if (!anyOnBoundaryTowards(*leaf, offset.x(), offset.y(), offset.z(), false)) continue;
                     states_.setValue(neighbour, kQueued);
                     next.push_back(leaf->origin().offsetBy(offset.x() * kLeafSize, offset.y() * kLeafSize,
                                                            offset.z() * kLeafSize));
@@ -439,7 +446,7 @@ float SurfaceFunction::operator()(const glm::dvec3& p, std::uint64_t& evaluation
     return value(escape.n, escape.de, regionDistance);
 }
 
-float SurfaceFunction::value(int n, double de, double regionDistance) const {
+inline float SurfaceFunction::value(int n, double de, double regionDistance) const {
     const double limit = background_;
     // DE = +inf (an orbit from the critical point) carries no distance: the clamp takes it.
     const double inner = n == 0 ? -epsilon_ : std::min(de / stretch_, limit) - epsilon_;
@@ -455,8 +462,6 @@ void SurfaceFunction::operator()(const glm::dvec3* points, std::size_t count, fl
     // Room for every point, written in place and cut to the points inside the region (no
     // push_back's capacity check per coordinate).
     batch.resize(count);
-    evaluated.resize(count);
-    distances.resize(count);
     std::array<double*, 8> coordinates;
     for (int k = 0; k < 8; ++k) coordinates[k] = batch.start(k);
     // Where every point lies deeper inside the region than the band, its distance d <= -limit
@@ -469,9 +474,24 @@ void SurfaceFunction::operator()(const glm::dvec3* points, std::size_t count, fl
         hi = glm::max(hi, points[i]);
     }
     const bool deep = count > 0 && region_.containsWithMargin(lo, hi, limit + voxelSize_);
+    if (deep) {  // every point: the slice map coordinate by coordinate, Slice::map's operations in its order
+        for (int k = 0; k < 8; ++k) {
+            const double origin = slice_.origin[k];
+            const double x = slice_.axes[0][k], y = slice_.axes[1][k], z = slice_.axes[2][k];
+            double* coordinate = coordinates[k];
+            for (std::size_t i = 0; i < count; ++i)
+                coordinate[i] = origin + points[i].x * x + points[i].y * y + points[i].z * z;
+        }
+        batch.evaluate(fractal_);
+        evaluations += count;
+        for (std::size_t i = 0; i < count; ++i) values[i] = value(batch.n(i), batch.de(i), -limit);
+        return;
+    }
+    evaluated.resize(count);
+    distances.resize(count);
     std::size_t inside = 0;
     for (std::size_t i = 0; i < count; ++i) {
-        const double regionDistance = deep ? -limit : region_.signedDistance(points[i]);
+        const double regionDistance = region_.signedDistance(points[i]);
         if (regionDistance > 0.0) {
             values[i] = float(std::min(regionDistance, limit));
             continue;
