@@ -474,13 +474,11 @@ void SurfaceFunction::operator()(const glm::dvec3* points, std::size_t count, fl
         hi = glm::max(hi, points[i]);
     }
     const bool deep = count > 0 && region_.containsWithMargin(lo, hi, limit + voxelSize_);
-    if (deep) {  // every point: the slice map coordinate by coordinate, Slice::map's operations in its order
+    if (deep) {                      // every point: the slice map coordinate by coordinate (vectorised)
+        const Slice slice = slice_;  // a local copy: the stores below cannot alias it
         for (int k = 0; k < 8; ++k) {
-            const double origin = slice_.origin[k];
-            const double x = slice_.axes[0][k], y = slice_.axes[1][k], z = slice_.axes[2][k];
             double* coordinate = coordinates[k];
-            for (std::size_t i = 0; i < count; ++i)
-                coordinate[i] = origin + points[i].x * x + points[i].y * y + points[i].z * z;
+            for (std::size_t i = 0; i < count; ++i) coordinate[i] = slice.coordinate(k, points[i]);
         }
         batch.evaluate(fractal_);
         evaluations += count;

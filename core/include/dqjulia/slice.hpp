@@ -34,9 +34,12 @@ struct Slice {
 
     DualQuat map(const glm::dvec3& p) const {
         Vec8 z;  // an array, not component(z, index): a loop without a branch per coordinate
-        for (int index = 0; index < 8; ++index)
-            z[index] = origin[index] + p.x * axes[0][index] + p.y * axes[1][index] + p.z * axes[2][index];
+        for (int index = 0; index < 8; ++index) z[index] = coordinate(index, p);
         return toDualQuat(z);
+    }
+    /// Coordinate `index` (0..7) of map(p).
+    double coordinate(int index, const glm::dvec3& p) const {
+        return origin[index] + p.x * axes[0][index] + p.y * axes[1][index] + p.z * axes[2][index];
     }
 };
 
