@@ -11,6 +11,7 @@ packages=(
   debootstrap   # tests/cleanroom: the add-on's library loaded in a minimal Debian root
   blender  # the bake tests load the VDB files and meshes in the real Blender (tests/blender)
   xvfb xauth glslang-tools  # the add-on's preview in a real Blender window (xvfb-run); its GLSL checked
+  libegl1 libgl1-mesa-dri mesa-vulkan-drivers  # the bpy wheels 5.2+ draw the preview without a window: EGL and Vulkan on Mesa's llvmpipe and lavapipe
   python3-openvdb python3-numpy  # tests/cli/pyopenvdb_test.py: a bake read by Debian's own OpenVDB
   povray  # tests/povray evaluate dqjulia.inc and render generated scenes in the real POV-Ray 3.7
   clang-format clang-tidy  # scripts/check-style.sh (the test style.check); ruff comes from scripts/tool-env.sh ruff
