@@ -47,7 +47,7 @@ if [ ${#packages[@]} -eq 0 ]; then
   key=minbase
 else
   key=$(IFS=+; echo "${packages[*]}")
-  [ ${#key} -le 48 ] || key=$(printf '%s\n' "${packages[@]}" | sha256sum | cut -c1-16)
+  [ ${#key} -le 64 ] || key=$(printf '%s\n' "${packages[@]}" | sha256sum | cut -c1-16)
 fi
 root="$cache/$suite-$recipe-$key"
 mkdir -p "$cache"
