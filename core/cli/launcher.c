@@ -31,24 +31,25 @@
  * dynamic loader's finaliser in rdx): __libc_start_main(main, argc, argv, init, fini,
  * rtld_fini, stack_end), with no init or fini (the launcher has no constructors), then main's
  * status to exit. Bound to the symbol version of glibc 2.2.5. */
-__asm__(".symver __libc_start_main, __libc_start_main@GLIBC_2.2.5\n"
-        ".text\n"
-        ".globl _start\n"
-        ".type _start, @function\n"
-        "_start:\n"
-        "    xorl %ebp, %ebp\n"        /* the outermost frame */
-        "    movq %rdx, %r9\n"         /* rtld_fini */
-        "    popq %rsi\n"              /* argc */
-        "    movq %rsp, %rdx\n"        /* argv */
-        "    andq $-16, %rsp\n"        /* the ABI's 16-byte alignment at a call */
-        "    pushq %rax\n"             /* (padding, keeps that alignment) */
-        "    pushq %rsp\n"             /* stack_end, the 7th argument */
-        "    xorl %r8d, %r8d\n"        /* fini */
-        "    xorl %ecx, %ecx\n"        /* init */
-        "    leaq main(%rip), %rdi\n"  /* main */
-        "    call *__libc_start_main@GOTPCREL(%rip)\n"
-        "    hlt\n"
-        ".size _start, . - _start\n");
+__asm__(
+    ".symver __libc_start_main, __libc_start_main@GLIBC_2.2.5\n"
+    ".text\n"
+    ".globl _start\n"
+    ".type _start, @function\n"
+    "_start:\n"
+    "    xorl %ebp, %ebp\n"       /* the outermost frame */
+    "    movq %rdx, %r9\n"        /* rtld_fini */
+    "    popq %rsi\n"             /* argc */
+    "    movq %rsp, %rdx\n"       /* argv */
+    "    andq $-16, %rsp\n"       /* the ABI's 16-byte alignment at a call */
+    "    pushq %rax\n"            /* (padding, keeps that alignment) */
+    "    pushq %rsp\n"            /* stack_end, the 7th argument */
+    "    xorl %r8d, %r8d\n"       /* fini */
+    "    xorl %ecx, %ecx\n"       /* init */
+    "    leaq main(%rip), %rdi\n" /* main */
+    "    call *__libc_start_main@GOTPCREL(%rip)\n"
+    "    hlt\n"
+    ".size _start, . - _start\n");
 
 /* "2.31" -> 2 and 31; 0 if the text does not start with MAJOR.MINOR. */
 static int parse_version(const char* text, int* major, int* minor) {

@@ -127,7 +127,8 @@ def check_refused(args, suite, checks):
         checks["%s: nothing written" % name] = not os.path.exists(os.path.join(here, "refused.png"))
         status, stdout, stderr = run_in(root, [inside_top + "/libexec/dqjulia/dqjulia", "--version"])
         message = (stdout + stderr).strip()
-        checks["%s: the command itself, without the launcher, is refused by the loader: %r" % (name, message)] = (
+        first = message.splitlines()[0].split(": ", 1)[-1] if message else ""
+        checks["%s: the command itself, without the launcher, is refused by the loader (%s)" % (name, first)] = (
             status != 0 and "GLIBC_" in message
         )
 
