@@ -291,8 +291,10 @@ class Fractal:
         cancel: threading.Event | None = None,
     ) -> numpy.ndarray:
         """Renders the picture (the parameters' camera, lights, material) and returns it as a
-        (height, width, 4) uint8 array of sRGB RGBA, top row first: the pixels of the PNG that
-        render_to_file writes. Width and height default to the parameters' render size."""
+        (height, width, 4) uint8 array, top row first: RGB is sRGB, the pixels of the PNG that
+        render_to_file writes (the surface over the background), and A is the surface's coverage
+        (0 where only the background shows). Width and height default to the parameters' render
+        size."""
         numpy = _numpy()
         if width is None or height is None:
             size = self.params["render"]
