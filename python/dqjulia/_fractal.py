@@ -335,9 +335,12 @@ class Fractal:
         the parameters' bake.grids asks for, at the parameters' bake resolution (or `resolution`,
         which sets bake.resolution: voxels across the largest side of the bounds). Returns what
         it cost."""
-        self._set_resolution(resolution)
-        self._run(lambda native_progress: self._context.bake_vdb(os.fspath(path), native_progress), progress, cancel)
-        return _stats(self._context.bake_stats())
+        return self._bake_work(
+            resolution,
+            lambda native_progress: self._context.bake_vdb(os.fspath(path), native_progress),
+            progress,
+            cancel,
+        )
 
     def mesh(
         self,
@@ -352,8 +355,7 @@ class Fractal:
         face as triangles. Vertex colours come with it unless the parameters' bake.mesh_colors is
         false."""
         numpy = _numpy()
-        self._set_resolution(resolution)
-        self._run(self._context.mesh_compute, progress, cancel)
+        stats = self._bake_work(resolution, self._context.mesh_compute, progress, cancel)
         vertex_count, triangle_count = self._context.mesh_sizes()
         vertices = numpy.empty((vertex_count, 3), dtype=numpy.float32)
         normals = numpy.empty((vertex_count, 3), dtype=numpy.float32)
@@ -374,7 +376,6 @@ class Fractal:
             self._context.mesh_copy_faces_into(
                 _pointer(quads, ctypes.c_uint32), quad_count, _pointer(triangles, ctypes.c_uint32), triangle_count
             )
-        stats = _stats(self._context.bake_stats())
         return Mesh(vertices=vertices, normals=normals, colors=colors, quads=quads, triangles=triangles, stats=stats)
 
     def mesh_to_file(
@@ -387,16 +388,24 @@ class Fractal:
     ) -> BakeStats:
         """Meshes the surface and writes it: .ply (binary, with normals and colours) or .obj, the
         file `dqjulia mesh` writes. Returns what it cost."""
-        self._set_resolution(resolution)
-        self._run(self._context.mesh_compute, progress, cancel)
+        stats = self._bake_work(resolution, self._context.mesh_compute, progress, cancel)
         self._context.mesh_write(os.fspath(path))
-        return _stats(self._context.bake_stats())
+        return stats
 
     # ----------------------------------------------------------------------------------------
 
-    def _set_resolution(self, resolution: int | None) -> None:
+    def _bake_work(
+        self,
+        resolution: int | None,
+        call: Callable[[_native.Progress], str],
+        progress: ProgressCallback | None,
+        cancel: threading.Event | None,
+    ) -> BakeStats:
+        """A bake or mesh call at `resolution` (sets bake.resolution; None keeps it); what it cost."""
         if resolution is not None:
             self._context.set_bake_resolution(resolution)
+        self._run(call, progress, cancel)
+        return _stats(self._context.bake_stats())
 
     def _run(
         self,

@@ -38,7 +38,7 @@ import threading
 try:
     from . import _buildinfo
 except ImportError:  # running from the source tree, not from a built add-on zip or wheel
-    _buildinfo = None
+    _buildinfo = None  # type: ignore[assignment]
 
 # The C ABI version this copy was built against (DQJ_VERSION_NUMBER = major*10000 +
 # minor*100 + patch, from dqjulia.h at build time). A library loads if its major version is
@@ -272,8 +272,8 @@ _library = None
 _load_error = None
 _library_path = None
 _dll_directory = None  # Windows: the library's folder, added to the DLL search path while loaded
-_features = frozenset()  # the FEATURES the loaded library has
-_bound = frozenset()  # the functions of _SIGNATURES it offers
+_features: "frozenset[str]" = frozenset()  # the FEATURES the loaded library has
+_bound: "frozenset[str]" = frozenset()  # the functions of _SIGNATURES it offers
 
 
 def version_text(number):
