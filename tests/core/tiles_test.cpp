@@ -1,147 +1,33 @@
-// Tiled bakes (tiles.hpp): tiles merged equal the one-piece bake voxel for voxel (every grid,
-// values bit for bit, active states, the inside and outside beyond the band), on leaf-aligned
-// and unaligned tilings and for band widths 1, 3 and 6; each tile keeps only its box; the merge
-// refuses tiles that do not belong together or do not cover the box once.
+// Tiled bakes (tiles.hpp): tiles merged equal the one-piece bake voxel for voxel (every grid a
+// bake can hold: surface, density, color, trap, iterations; values bit for bit, active states,
+// the inside and outside beyond the band), on leaf-aligned and unaligned tilings, for band
+// widths 1, 3 and 6 and colour depths from the band to 15 voxels below it (the halo's reach;
+// tiles_long_test.cpp: 512^3, where a too small halo showed first); each tile keeps only its
+// box; the merge refuses tiles that do not belong together or do not cover the box once.
 #include <gtest/gtest.h>
 
-#include <algorithm>
-#include <bit>
-#include <cstdint>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
-#include <map>
+#include <string>
+#include <vector>
 
-#include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 
 #include "dqjulia/bake.hpp"
 #include "dqjulia/params.hpp"
 #include "dqjulia/tiles.hpp"
 #include "dqjulia/version.h"
-#include "test_support.hpp"
+#include "sparse_sampler.hpp"  // bakeVoxelSize (internal)
+#include "tile_merge_check.hpp"
 
 namespace fs = std::filesystem;
 using namespace dqj;
+using dqj::test::Tiles;
+using dqj::test::readVdb;
+using dqj::test::VdbFile;
 
 namespace {
-
-class Tiles : public ::testing::Test {
-protected:
-    static void SetUpTestSuite() { openvdb::initialize(); }
-    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_tiles"); }
-    void TearDown() override { fs::remove_all(dir_); }
-    std::string path(const std::string& name) const { return (dir_ / name).string(); }
-
-    /// Bakes every tile of `tiling` beside "whole.vdb" and returns their paths.
-    std::vector<std::string> bakeTiles(const Params& params, const std::string& tiling) {
-        Tile tile = parseTiling(tiling);
-        std::vector<std::string> paths;
-        for (tile.index = 1; tile.index <= tileCount(tile); ++tile.index) {
-            BakeOptions options;
-            options.tile = tile;
-            paths.push_back(tilePath(path("whole.vdb"), tile.index));
-            bakeVdb(params, paths.back(), options);
-        }
-        return paths;
-    }
-    fs::path dir_;
-};
-
-struct VdbFile {
-    std::map<std::string, openvdb::GridBase::Ptr> grids;
-    openvdb::MetaMap::Ptr metadata;
-};
-
-VdbFile readVdb(const std::string& path) {
-    openvdb::io::File file(path);
-    file.open();
-    VdbFile result;
-    const openvdb::GridPtrVecPtr grids = file.getGrids();
-    for (const openvdb::GridBase::Ptr& grid : *grids) result.grids[grid->getName()] = grid;
-    result.metadata = file.getMetadata();
-    file.close();
-    return result;
-}
-
-/// Voxels compared and those that differ (value bits or active state) between two grids of
-/// one type, over the bounding box of both grids' active voxels grown by 2 voxels.
-struct Comparison {
-    std::uint64_t voxels = 0;
-    std::uint64_t differences = 0;
-    std::uint64_t active = 0;
-    std::uint64_t stateDiffers = 0;  // active in one grid only
-    double largest = 0.0;            // the largest value difference where both are active
-};
-
-double distance(float u, float v) { return std::abs(double(u) - double(v)); }
-double distance(const openvdb::Vec3s& u, const openvdb::Vec3s& v) { return double((u - v).length()); }
-/// Bit for bit, so that -0 and 0 (or two NaNs) are told apart.
-bool sameBits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b); }
-bool sameBits(const openvdb::Vec3s& a, const openvdb::Vec3s& b) {
-    return sameBits(a.x(), b.x()) && sameBits(a.y(), b.y()) && sameBits(a.z(), b.z());
-}
-
-template <typename GridT>
-Comparison compareGrids(const GridT& a, const GridT& b) {
-    openvdb::CoordBBox box = a.evalActiveVoxelBoundingBox();
-    box.expand(b.evalActiveVoxelBoundingBox());
-    box.expand(2);
-    auto x = a.getConstAccessor();
-    auto y = b.getConstAccessor();
-    Comparison result;
-    for (auto ijk = box.begin(); ijk; ++ijk) {
-        const auto u = x.getValue(*ijk), v = y.getValue(*ijk);
-        const bool on = x.isValueOn(*ijk);
-        ++result.voxels;
-        result.active += on;
-        if (on != y.isValueOn(*ijk) || !sameBits(u, v)) {
-            ++result.differences;
-            if (on != y.isValueOn(*ijk))
-                ++result.stateDiffers;
-            else
-                result.largest = std::max(result.largest, distance(u, v));
-        }
-    }
-    return result;
-}
-
-/// Every grid of the one-piece file against the merged file's; both hold the same grids and
-/// the same file metadata.
-Comparison compareFiles(const std::string& whole, const std::string& merged) {
-    const VdbFile a = readVdb(whole), b = readVdb(merged);
-    Comparison total;
-    EXPECT_EQ(a.grids.size(), b.grids.size());
-    for (const auto& [name, grid] : a.grids) {
-        const auto other = b.grids.find(name);
-        if (other == b.grids.end()) {
-            ADD_FAILURE() << "the merged file has no grid " << name;
-            continue;
-        }
-        EXPECT_EQ(grid->transform(), other->second->transform()) << name;
-        EXPECT_EQ(grid->getGridClass(), other->second->getGridClass()) << name;
-        Comparison one;
-        if (auto vectors = openvdb::gridPtrCast<openvdb::Vec3SGrid>(grid))
-            one = compareGrids(*vectors, *openvdb::gridPtrCast<openvdb::Vec3SGrid>(other->second));
-        else
-            one = compareGrids(*openvdb::gridPtrCast<openvdb::FloatGrid>(grid),
-                               *openvdb::gridPtrCast<openvdb::FloatGrid>(other->second));
-        // Every grid the one-piece bake's exactly; the attribute grids too, since each voxel's
-        // nearest seed (nearest_seed.hpp) is within the tile's halo (the fast sweeps they were
-        // made by before depended a little on the swept domain near a tile's edge).
-        EXPECT_EQ(one.stateDiffers, 0u) << name;
-        EXPECT_EQ(one.differences, 0u) << name << ": " << one.differences << " of " << one.voxels
-                                       << " voxels differ, by at most " << one.largest;
-        EXPECT_GT(one.active, 100u) << name;
-        total.voxels += one.voxels;
-        total.differences += one.differences;
-        total.active += one.active;
-    }
-    for (const char* key : {"creator", "dqjulia_parameters"})
-        EXPECT_EQ(a.metadata->metaValue<std::string>(key), b.metadata->metaValue<std::string>(key)) << key;
-    EXPECT_EQ(a.metadata->metaValue<double>("dqjulia_voxel_size"), b.metadata->metaValue<double>("dqjulia_voxel_size"));
-    EXPECT_FALSE((*b.metadata)["dqjulia_tiling"]);
-    return total;
-}
 
 struct Case {
     const char* name;
@@ -149,8 +35,23 @@ struct Case {
     double band;
     const char* tiling;
     bool dual;
-    bool attributes;  // the colour and trap grids too, reaching below the band
+    double colorDepth;  // 0: no attribute grids; else color, trap and iterations too, this deep
+    int crop = 0;       // else a 128^3 crop of the default bake at crop^3 (voxel size, seam, depth)
 };
+
+/// A 128^3 crop of the default fractal's bake at `resolution`^3: its voxel size and colour
+/// depth in voxels, the x = 0 plane (the seam of its 2x1x1 tiling) through the box's middle, and
+/// the thick middle of the set below it (at 512^3 the crop's box is the one of the voxels where
+/// a too small halo first showed, z from 0 to 128 voxels).
+void cropOf(Params& params, int resolution) {
+    Params whole;
+    whole.bake.resolution = resolution;
+    const double h = bakeVoxelSize(whole);
+    const double z = resolution / 8 - 64;  // 0 at 512^3, 64 at 1024^3
+    params.bake.bounds = Box{glm::dvec3(-64.0 * h, -64.0 * h, z * h), glm::dvec3(64.0 * h, 64.0 * h, (z + 128.0) * h)};
+    params.bake.resolution = 128;
+    params.bake.colorDepth = (std::ceil(0.02 * resolution) - 0.5) / 128.0;
+}
 
 class TilesMerge : public Tiles, public ::testing::WithParamInterface<Case> {};
 
@@ -160,35 +61,37 @@ TEST_P(TilesMerge, EqualTheOnePieceBakeVoxelForVoxel) {
     params.bake.resolution = c.resolution;
     params.bake.bandWidth = c.band;
     params.bake.grids = {BakeGrid::Surface, BakeGrid::Density};
-    if (c.attributes) {
-        params.bake.grids.insert(params.bake.grids.end(), {BakeGrid::Color, BakeGrid::Trap});
-        params.bake.colorDepth = 0.1;  // 7 voxels below the band: the halo grows for them
+    if (c.colorDepth > 0.0) {
+        params.bake.grids.insert(params.bake.grids.end(), {BakeGrid::Color, BakeGrid::Trap, BakeGrid::Iterations});
+        params.bake.colorDepth = c.colorDepth;
     }
+    if (c.crop) cropOf(params, c.crop);
     if (c.dual) {
         params.fractal.variant = Variant::Dual;
         params.fractal.c = toDualQuat({-0.2, 0.6, 0.2, 0.0, 0.0, 0.0, 0.0, 0.0});
         params.fractal.iterations = 12;
     }
-    const BakeStats whole = bakeVdb(params, path("whole.vdb"));
-    const std::vector<std::string> tiles = bakeTiles(params, c.tiling);
-    const MergeStats merged = mergeTiles(tiles, path("merged.vdb"));
-    EXPECT_EQ(merged.tiles, tileCount(parseTiling(c.tiling)));
-    EXPECT_EQ(merged.activeVoxels, whole.activeVoxels);
-    const Comparison comparison = compareFiles(path("whole.vdb"), path("merged.vdb"));
-    EXPECT_EQ(comparison.differences, 0u);
-    std::printf("[ figures  ] %s: %s tiles of %d^3, band %g: %llu voxels compared (%llu active), %llu differ\n", c.name,
-                c.tiling, c.resolution, c.band, static_cast<unsigned long long>(comparison.voxels),
-                static_cast<unsigned long long>(comparison.active),
-                static_cast<unsigned long long>(comparison.differences));
+    dqj::test::checkMergeEqualsWhole(*this, params, c.tiling, c.name);
 }
 
 // The default bake's index box at 64^3 is 69 voxels a side from -34: halves split at 0 (on a
 // leaf boundary), thirds at -11 and 12 (not); at 128^3, 133 voxels from -66, thirds at -22, 22.
+// Colour depths in voxels below the band (the region's 26-neighbour dilation, sqrt 3 times as
+// deep along the diagonals): 0.1 at 64^3 is 4, 0.15 at 96^3 12, 0.12 at 120^3 12, 0.08 at
+// 160^3 with band 1 12, 0.15 at 112^3 with band 6 11, 0.05 at 200^3 7; the halo grows with
+// each (tileHalo).
 INSTANTIATE_TEST_SUITE_P(
     Tilings, TilesMerge,
-    ::testing::Values(Case{"aligned", 64, 3.0, "2x2x2", false, true}, Case{"unaligned", 64, 3.0, "3x2x1", false, true},
-                      Case{"band1", 64, 1.0, "3x1x1", false, false}, Case{"band6", 64, 6.0, "1x3x1", false, false},
-                      Case{"dual", 64, 3.0, "1x1x3", true, false}, Case{"r128", 128, 3.0, "3x1x1", false, false}),
+    ::testing::Values(Case{"aligned", 64, 3.0, "2x2x2", false, 0.1}, Case{"unaligned", 64, 3.0, "3x2x1", false, 0.1},
+                      Case{"band1", 64, 1.0, "3x1x1", false, 0.0}, Case{"band6", 64, 6.0, "1x3x1", false, 0.0},
+                      Case{"dual", 64, 3.0, "1x1x3", true, 0.0}, Case{"r128", 128, 3.0, "3x1x1", false, 0.0},
+                      Case{"deep96", 96, 3.0, "2x1x1", false, 0.15}, Case{"deep120", 120, 3.0, "1x3x2", false, 0.12},
+                      Case{"deepBand1", 160, 1.0, "2x2x1", false, 0.08}, Case{"deepBand6", 112, 6.0, "3x1x1", false, 0.15},
+                      Case{"deepDual", 96, 3.0, "1x2x2", true, 0.15}, Case{"r200", 200, 3.0, "1x1x2", false, 0.05},
+                      Case{"seam512", 128, 3.0, "2x1x1", false, 0.02, 512},
+                      Case{"seam1024", 128, 3.0, "2x1x1", false, 0.02, 1024},
+                      Case{"thirds1024", 128, 3.0, "3x1x1", false, 0.02, 1024},
+                      Case{"halves1024y", 128, 3.0, "1x2x1", false, 0.02, 1024}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST_F(Tiles, EachTileKeepsOnlyItsBoxAndSaysWhichItIs) {
