@@ -1,8 +1,8 @@
 // tile_merge_check.hpp - what the tiled-bake tests share (tiles_test.cpp, tiles_long_test.cpp):
-// a scratch folder, baking every tile of a tiling, and the merged file compared with the
-// one-piece bake's voxel for voxel, every grid (values bit for bit and active states, over the
-// bounding box of both grids' active voxels grown by 2, so the inside and outside beyond the
-// band too).
+// a scratch folder, baking every tile of a tiling, the merged file compared with the one-piece
+// bake's voxel for voxel, every grid (values bit for bit and active states, over the bounding
+// box of both grids' active voxels grown by 2, so the inside and outside beyond the band too),
+// and crops of large bakes at their voxel size.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -23,7 +23,9 @@
 #include "dqjulia/bake.hpp"
 #include "dqjulia/params.hpp"
 #include "dqjulia/tiles.hpp"
+#include "sparse_sampler.hpp"  // bakeIndexBox, bakeVoxelSize (internal)
 #include "test_support.hpp"
+#include "tile_geometry.hpp"  // tileWindow (internal)
 
 namespace dqj::test {
 
@@ -151,6 +153,14 @@ inline Comparison compareFiles(const std::string& whole, const std::string& merg
 /// file with the whole one (compareFiles); prints the figures.
 inline Comparison checkMergeEqualsWhole(Tiles& test, const Params& params, const std::string& tiling,
                                         const std::string& label) {
+    // A tile whose window (its box grown by the halo) holds the whole bake's box bakes the whole
+    // and proves nothing: every case has each tile's window end inside the box on a cut face.
+    const openvdb::CoordBBox full = bakeIndexBox(params);
+    Tile tile = parseTiling(tiling);
+    for (tile.index = 1; tile.index <= tileCount(tile); ++tile.index)
+        EXPECT_FALSE(tileWindow(params, tile).isInside(full))
+            << label << ": tile " << tile.index << "'s halo of " << tileHalo(params.bake) << " covers the whole box "
+            << full << ", so the case tests nothing";
     const BakeStats whole = bakeVdb(params, test.path("whole.vdb"));
     const std::vector<std::string> tiles = test.bakeTiles(params, tiling);
     const MergeStats merged = mergeTiles(tiles, test.path("merged.vdb"));
@@ -165,6 +175,22 @@ inline Comparison checkMergeEqualsWhole(Tiles& test, const Params& params, const
                 static_cast<unsigned long long>(comparison.active),
                 static_cast<unsigned long long>(comparison.differences));
     return comparison;
+}
+
+/// A crop of the default fractal's bake at `resolution`^3, `extents` voxels along x, y and z,
+/// with that bake's voxel size and colour depth in voxels (so its halo): the planes x = 0 and
+/// y = 0 (the seams of 2x1x1 and 1x2x1 tilings) through the crop's middle, and the thick middle
+/// of the set below it in z (at 512^3 and extents of 128 the box of the voxels where a too
+/// small halo first showed, z from 0 to 128 voxels). Its largest side is its resolution.
+inline void cropOf(Params& params, int resolution, const openvdb::Coord& extents) {
+    Params whole;
+    whole.bake.resolution = resolution;
+    const double h = bakeVoxelSize(whole);
+    const double z = resolution / 8 - 64;  // 0 at 512^3, 64 at 1024^3
+    const glm::dvec3 half(extents.x() / 2.0, extents.y() / 2.0, 0.0);
+    params.bake.bounds = Box{glm::dvec3(-half.x, -half.y, z) * h, glm::dvec3(half.x, half.y, z + extents.z()) * h};
+    params.bake.resolution = extents[extents.maxIndex()];
+    params.bake.colorDepth = (std::ceil(0.02 * resolution) - 0.5) / params.bake.resolution;
 }
 
 }  // namespace dqj::test
