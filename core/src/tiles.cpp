@@ -210,10 +210,13 @@ int tileHalo(const BakeSettings& bake) {
     //   order of their voxels (leaf by leaf, each leaf's in offset order), a fixed order of
     //   coordinates, so any two seeds they share compare alike.
     // So a halo of levelSet + rounds + max(dilation, 1) gives every voxel of K the whole bake's
-    // seed, ties included, hence its colour, trap and iteration count. (Before, the halo added
-    // only the dilation: a 26-neighbour dilation reaches sqrt 3 times as deep along the
-    // diagonals, and at 512^3 voxels 16 deep on a seam took the tile's seeds on its window's cut
-    // face, 16 voxels away, for the surface 16.4 voxels away.)
+    // seed, ties included, hence its colour, trap and iteration count. Nothing in this uses the
+    // resolution, the tiling or where the tile lies (on the whole bake's outer faces the window
+    // is cut where the whole is), only the band and the colour depth in voxels, which the halo
+    // follows: it holds at any size. (Before, the halo added only the dilation and the seeds
+    // spread until nothing changed, so nothing bounded how far a seed travels: at 512^3 a few
+    // seam voxels took seeds from near the tile's cut face, where the tile's level set, and so
+    // its seeds, are not the whole bake's. tiles_test.cpp, seam512, holds that case.)
     return levelSet + attributeRounds(bake) + std::max(attributeDilation(bake), 1);
 }
 

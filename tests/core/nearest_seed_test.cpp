@@ -159,8 +159,7 @@ Input randomInput(int size, int holes, int count, unsigned seed) {
         const Coord voxel(at(random), at(random), at(random));
         const bool centre = index % 2 == 0;
         input.voxels.push_back(voxel);
-        input.points.push_back(voxel.asVec3s() +
-                               (centre ? Vec3f(0.0f) : Vec3f(off(random), off(random), off(random))));
+        input.points.push_back(voxel.asVec3s() + (centre ? Vec3f(0.0f) : Vec3f(off(random), off(random), off(random))));
     }
     return input;
 }
@@ -248,9 +247,10 @@ TEST(NearestSeeds, AfterRRoundsAVoxelsSeedDependsOnNothingFurtherThanRSteps) {
         const Input c = agreeWithin(a, other, closer);
         differingTooClose += differing(*idsA, a, *dqj::nearestSeeds(c.region, c.voxels, c.points, rounds), c);
     }
-    std::printf("%zu voxels alike after %d rounds (%zu of them as near to another seed); without a bound %d "
-                "differ, with one step less agreed %d\n",
-                voxels, rounds, ties, differingWithoutBound, differingTooClose);
+    std::printf(
+        "%zu voxels alike after %d rounds (%zu of them as near to another seed); without a bound %d "
+        "differ, with one step less agreed %d\n",
+        voxels, rounds, ties, differingWithoutBound, differingTooClose);
     EXPECT_GT(voxels, 4000u);
     EXPECT_GT(ties, 10u);
     EXPECT_GT(differingWithoutBound, 0);

@@ -168,12 +168,12 @@ inline Comparison checkMergeEqualsWhole(Tiles& test, const Params& params, const
     EXPECT_EQ(merged.activeVoxels, whole.activeVoxels);
     const Comparison comparison = compareFiles(test.path("whole.vdb"), test.path("merged.vdb"));
     EXPECT_EQ(comparison.differences, 0u);
-    std::printf("[ figures  ] %s: %s tiles of %d^3, band %g, colour depth %g (halo %d): %llu voxels compared "
-                "(%llu active), %llu differ\n",
-                label.c_str(), tiling.c_str(), params.bake.resolution, params.bake.bandWidth, params.bake.colorDepth,
-                tileHalo(params.bake), static_cast<unsigned long long>(comparison.voxels),
-                static_cast<unsigned long long>(comparison.active),
-                static_cast<unsigned long long>(comparison.differences));
+    std::printf(
+        "[ figures  ] %s: %s tiles of %d^3, band %g, colour depth %g (halo %d): %llu voxels compared "
+        "(%llu active), %llu differ\n",
+        label.c_str(), tiling.c_str(), params.bake.resolution, params.bake.bandWidth, params.bake.colorDepth,
+        tileHalo(params.bake), static_cast<unsigned long long>(comparison.voxels),
+        static_cast<unsigned long long>(comparison.active), static_cast<unsigned long long>(comparison.differences));
     return comparison;
 }
 

@@ -34,13 +34,13 @@ TEST_P(TilesLong, EqualTheOnePieceBakeVoxelForVoxel) {
 // Colour depth 0.02: 11 voxels at 512^3 (halo 46), 8 at 384^3 (37), 12 at 576^3 (49), 21 at
 // 1024^3 (76), 41 at 2048^3 (136); the crops are wide enough across their seams that no tile's
 // window holds the whole crop.
-INSTANTIATE_TEST_SUITE_P(
-    Sizes, TilesLong,
-    ::testing::Values(Case{"r512", 512, "2x1x1"}, Case{"r384", 384, "2x2x2"}, Case{"r576", 576, "1x3x1"},
-                      Case{"seam1024", 1024, "2x1x1", openvdb::Coord(256, 128, 128)},
-                      Case{"thirds1024", 1024, "3x1x1", openvdb::Coord(256, 128, 128)},
-                      Case{"halves1024y", 1024, "1x2x1", openvdb::Coord(128, 256, 128)},
-                      Case{"seam2048", 2048, "2x1x1", openvdb::Coord(320, 128, 128)}),
-    [](const auto& info) { return std::string(info.param.name); });
+INSTANTIATE_TEST_SUITE_P(Sizes, TilesLong,
+                         ::testing::Values(Case{"r512", 512, "2x1x1"}, Case{"r384", 384, "2x2x2"},
+                                           Case{"r576", 576, "1x3x1"},
+                                           Case{"seam1024", 1024, "2x1x1", openvdb::Coord(256, 128, 128)},
+                                           Case{"thirds1024", 1024, "3x1x1", openvdb::Coord(256, 128, 128)},
+                                           Case{"halves1024y", 1024, "1x2x1", openvdb::Coord(128, 256, 128)},
+                                           Case{"seam2048", 2048, "2x1x1", openvdb::Coord(320, 128, 128)}),
+                         [](const auto& info) { return std::string(info.param.name); });
 
 }  // namespace

@@ -23,8 +23,8 @@
 
 namespace fs = std::filesystem;
 using namespace dqj;
-using dqj::test::Tiles;
 using dqj::test::readVdb;
+using dqj::test::Tiles;
 using dqj::test::VdbFile;
 
 namespace {
@@ -73,7 +73,8 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(Case{"aligned", 64, 3.0, "2x2x2", false, 0.05}, Case{"unaligned", 64, 3.0, "3x2x1", false, 0.05},
                       Case{"band1", 64, 1.0, "3x1x1", false, 0.0}, Case{"band6", 64, 6.0, "1x3x1", false, 0.0},
                       Case{"dual", 64, 3.0, "1x1x3", true, 0.0}, Case{"r128", 128, 3.0, "3x1x1", false, 0.0},
-                      Case{"deepBand1", 160, 1.0, "2x2x1", false, 0.08}, Case{"deepBand6", 160, 6.0, "3x1x1", false, 0.06},
+                      Case{"deepBand1", 160, 1.0, "2x2x1", false, 0.08},
+                      Case{"deepBand6", 160, 6.0, "3x1x1", false, 0.06},
                       Case{"deepDual", 128, 3.0, "1x2x2", true, 0.05}, Case{"r200", 200, 3.0, "1x1x2", false, 0.05},
                       Case{"seam512", 128, 3.0, "2x1x1", false, 0.02, 512}),
     [](const auto& info) { return std::string(info.param.name); });
