@@ -186,7 +186,7 @@ inline void cropOf(Params& params, int resolution, const openvdb::Coord& extents
     Params whole;
     whole.bake.resolution = resolution;
     const double h = bakeVoxelSize(whole);
-    const double z = resolution / 8 - 64;  // 0 at 512^3, 64 at 1024^3
+    const double z = resolution / 8.0 - 64.0;  // 0 at 512^3, 64 at 1024^3
     const glm::dvec3 half(extents.x() / 2.0, extents.y() / 2.0, 0.0);
     params.bake.bounds = Box{glm::dvec3(-half.x, -half.y, z) * h, glm::dvec3(half.x, half.y, z + extents.z()) * h};
     params.bake.resolution = extents[extents.maxIndex()];
