@@ -1,4 +1,5 @@
 // dqjulia explore: a contact sheet of random constants (seeded), one parameter file per tile.
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 
@@ -6,8 +7,10 @@
 #include "common.hpp"
 #include "contact_sheet.hpp"
 #include "explore.hpp"
+#include "atomic_file.hpp"
 #include "dqjulia/render.hpp"
 #include "file_names.hpp"
+#include "image_writer.hpp"
 
 namespace dqj::cli {
 namespace {
@@ -38,7 +41,17 @@ int runExplore(const ExploreCommandOptions& options) {
     std::error_code error;
     fs::create_directories(folder, error);
     if (error) throw std::runtime_error("cannot create folder '" + options.folder + "': " + error.message());
-    checkOutputPath(utf8FromPath(sheetPath), options.force, "--output");
+    // The sheet and every tile's picture and parameter file: checked now, published together at the end.
+    auto tileName = [](std::size_t index) {
+        char name[32];
+        std::snprintf(name, sizeof name, "tile_%02zu", index + 1);
+        return std::string(name);
+    };
+    std::vector<NamedPath> outputs{{"--output", utf8FromPath(sheetPath)}};
+    for (std::size_t index = 0; index < std::size_t(options.count); ++index)
+        for (const char* extension : {".png", ".json"})
+            outputs.push_back({"--output", utf8FromPath(folder / (tileName(index) + extension))});
+    checkOutputs(outputs, options.fractal.inputs(), options.force);
 
     ExploreOptions exploreOptions;
     exploreOptions.seed = options.seed;
@@ -49,24 +62,26 @@ int runExplore(const ExploreCommandOptions& options) {
                                  " attempts; try fewer iterations or another slice");
 
     ProgressBar progress("exploring", options.quiet);
+    AtomicFileSet files(existingPolicy(options.force));
     std::vector<SheetTile> tiles;
     for (std::size_t index = 0; index < found.tiles.size(); ++index) {
         Params tile = found.tiles[index];
-        char name[32];
-        std::snprintf(name, sizeof name, "tile_%02zu", index + 1);
-        tile.output.path = utf8FromPath(folder / (std::string(name) + ".png"));
+        const std::string name = tileName(index);
+        tile.output.path = utf8FromPath(folder / (name + ".png"));
         // Each tile's share of the progress bar; Ctrl-C stops between and inside tiles.
         const double start = double(index) / found.tiles.size(), share = 1.0 / found.tiles.size();
         const ProgressCallback callback = progress.callback();
         const RenderResult result = render(tile, [&](double fraction) { return callback(start + share * fraction); });
-        writeImage(result.image, tile.output.path, ImageFormat::Png8);
-        saveParams(tile, utf8FromPath(folder / (std::string(name) + ".json")));
-        tiles.push_back({result.image, std::string(name) + "  " + constantText(tile.fractal.c, 3)});
+        writeImage(result.image, files.add(tile.output.path), ImageFormat::Png8);
+        files.add(utf8FromPath(folder / (name + ".json"))).stream() << toJson(tile);
+        tiles.push_back({result.image, name + "  " + constantText(tile.fractal.c, 3)});
     }
     progress.finish();
     SheetLayout layout;
     layout.columns = options.columns;
-    writeImage(composeSheet(tiles, layout), utf8FromPath(sheetPath), ImageFormat::Png8, existingPolicy(options.force));
+    writeImage(composeSheet(tiles, layout), files.add(utf8FromPath(sheetPath)), ImageFormat::Png8);
+    if (interrupted()) throw Cancelled();  // a signal in the last moments of the work: write nothing
+    files.commit();
     if (!options.quiet)
         std::cerr << "wrote " << utf8FromPath(sheetPath) << " and " << tiles.size()
                   << " tiles (tile_NN.png, tile_NN.json) to " << options.folder << "; " << found.skippedEmpty << " of "
@@ -91,7 +106,7 @@ Runner addExploreCommand(CLI::App& app) {
     command->add_option("-s,--samples", options->samples, "Anti-aliasing per tile: S x S rays a pixel")
         ->check(CLI::Range(1, 8));
     command->add_option("-o,--output", options->folder, "Folder for the sheet, tiles and parameter files");
-    command->add_flag("-f,--force", options->force, "Overwrite an existing sheet");
+    command->add_flag("-f,--force", options->force, "Overwrite an existing sheet, tiles and parameter files");
     command->add_flag("-q,--quiet", options->quiet, "No progress bar or summary");
     return [options] { return reportErrors("explore", [&] { return runExplore(*options); }); };
 }
