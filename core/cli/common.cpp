@@ -275,18 +275,22 @@ void checkOutputs(const std::vector<NamedPath>& outputs, const std::vector<Named
 MessageEscaping::MessageEscaping()
     : out_(std::cout.rdbuf()),
       err_(std::cerr.rdbuf()),
+      log_(std::clog.rdbuf()),
       escapedOut_(std::make_unique<EscapingBuffer>(out_)),
       escapedErr_(std::make_unique<EscapingBuffer>(err_)) {
     terminalBuffer = err_;
     std::cout.rdbuf(escapedOut_.get());
     std::cerr.rdbuf(escapedErr_.get());
+    std::clog.rdbuf(escapedErr_.get());  // a library's log lines too (its own object, the same stderr)
 }
 
 MessageEscaping::~MessageEscaping() {
     std::cout.flush();
     std::cerr.flush();
+    std::clog.flush();
     std::cout.rdbuf(out_);
     std::cerr.rdbuf(err_);
+    std::clog.rdbuf(log_);
     terminalBuffer = nullptr;
 }
 

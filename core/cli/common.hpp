@@ -67,10 +67,10 @@ void checkOutputs(const std::vector<NamedPath>& outputs, const std::vector<Named
 /// the write fails), even if it appeared while the work ran.
 inline Existing existingPolicy(bool force) { return force ? Existing::Replace : Existing::Keep; }
 
-/// While it lives, every character written to std::cout and std::cerr (the command's messages,
-/// the argument parser's and any library's) goes through printableText(), so no name or value
-/// can drive the terminal: control characters arrive as \xNN. Only the progress bar draws its
-/// own control codes, through terminalBuffer().
+/// While it lives, every character written to std::cout, std::cerr and std::clog (the command's
+/// messages, the argument parser's and any library's) goes through printableText(), so no name
+/// or value can drive the terminal: control characters arrive as \xNN. Only the progress bar
+/// draws its own control codes, through the buffer standard error had before (its label escaped).
 class MessageEscaping {
 public:
     MessageEscaping();
@@ -81,6 +81,7 @@ public:
 private:
     std::streambuf* out_;
     std::streambuf* err_;
+    std::streambuf* log_;
     std::unique_ptr<std::streambuf> escapedOut_;
     std::unique_ptr<std::streambuf> escapedErr_;
 };

@@ -297,8 +297,8 @@ struct AtomicFile::State {
 #ifdef _WIN32
     HANDLE asideHandle = INVALID_HANDLE_VALUE;  // holds the file set aside: no other writer deletes it
 #else
-    int pathFd = -1;  // an O_PATH reference to the unnamed file between prepare() and publish()
-    int lockFd = -1;  // keeps a named temporary locked between prepare() and publish()
+    int pathFd = -1;   // an O_PATH reference to the unnamed file between prepare() and publish()
+    int lockFd = -1;   // keeps a named temporary locked between prepare() and publish()
     int asideFd = -1;  // keeps the file set aside locked
     dev_t device = 0;  // the written file's identity, so withdraw() removes only that file
     ino_t inode = 0;
@@ -436,8 +436,7 @@ std::string windowsNameProblem(const std::string& path) {
     components.push_back(component);
     std::size_t first = 0;
     if (components.size() >= 3 && components[0].empty() && components[1].empty()) {
-        if (components[2] == ".")
-            return "it is in Windows' device namespace (\\\\.\\), which names devices, not files";
+        if (components[2] == ".") return "it is in Windows' device namespace (\\\\.\\), which names devices, not files";
         if (components[2] == "?") {
             first = 3;
             if (components.size() > first && asciiEqualIgnoringCase(components[first], "UNC")) first += 3;

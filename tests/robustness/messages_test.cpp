@@ -19,14 +19,17 @@ namespace {
 
 /// Escape sequences a terminal obeys: set the window title, red text, a carriage return that
 /// overwrites the line, DEL, and CSI as a C1 control in UTF-8 (U+009B).
-const std::string kHostile = "\x1b]0;owned\x07\x1b[31mred\rover\x7f\xc2\x9b" "2J";
+const std::string kHostile =
+    "\x1b]0;owned\x07\x1b[31mred\rover\x7f\xc2\x9b"
+    "2J";
 
 /// The first control character in `text` that is not a newline or a tab, as "\\xNN at offset N", or "".
 std::string rawControl(const std::string& text) {
     for (std::size_t index = 0; index < text.size(); ++index) {
         const auto byte = static_cast<unsigned char>(text[index]);
         const auto next = index + 1 < text.size() ? static_cast<unsigned char>(text[index + 1]) : 0;
-        if ((byte < 0x20 && byte != '\n' && byte != '\t') || byte == 0x7f || (byte == 0xc2 && next >= 0x80 && next <= 0x9f))
+        if ((byte < 0x20 && byte != '\n' && byte != '\t') || byte == 0x7f ||
+            (byte == 0xc2 && next >= 0x80 && next <= 0x9f))
             return "byte " + std::to_string(byte) + " at offset " + std::to_string(index);
     }
     return "";
@@ -163,10 +166,11 @@ TEST_F(Messages, EveryTextFlagOfEveryCommandIsEscapedInEveryMessage) {
     EXPECT_GE(flags, 30) << "the flags were not found in the help";
     // Every flag whose value names a file is quoted back (escaped) by the message that refuses it.
     for (const std::string& name : notQuoted) {
-        const bool pathFlag = name.find("--output") != std::string::npos || name.find("--params") != std::string::npos ||
-                              name.find("--save-params") != std::string::npos ||
-                              name.find("--voxels") != std::string::npos || name.find("--script") != std::string::npos ||
-                              name.find("--template") != std::string::npos || name.find("sheet --tile") == 0;
+        const bool pathFlag =
+            name.find("--output") != std::string::npos || name.find("--params") != std::string::npos ||
+            name.find("--save-params") != std::string::npos || name.find("--voxels") != std::string::npos ||
+            name.find("--script") != std::string::npos || name.find("--template") != std::string::npos ||
+            name.find("sheet --tile") == 0;
         EXPECT_FALSE(pathFlag) << name << ": its value appears in no message";
     }
 }

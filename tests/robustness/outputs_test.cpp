@@ -50,20 +50,14 @@ protected:
     }
     /// `arguments` with DIR replaced by the scratch folder, run in it.
     dqj::test::CommandResult run(std::string arguments, const std::string& input = "") {
-        for (std::size_t at; (at = arguments.find("DIR")) != std::string::npos;) arguments.replace(at, 3, dir_.string());
+        for (std::size_t at; (at = arguments.find("DIR")) != std::string::npos;)
+            arguments.replace(at, 3, dir_.string());
         return dqj::test::runCommand(DQJ_CLI, arguments, dir_, input);
     }
     void write(const fs::path& path, const std::string& text) const { std::ofstream(path, std::ios::binary) << text; }
-    /// A small tmpfs at dir_/name of `size`; false if mounting is not allowed here (not root).
-    bool mountTmpfs(const std::string& name, const std::string& size) {
-        mount_ = dir_ / name;
-        disk_.emplace(mount_, size);
-        return disk_->mounted();
-    }
 
     fs::path dir_;
-    fs::path mount_;
-    std::optional<dqj::test::Tmpfs> disk_;
+    std::optional<dqj::test::Tmpfs> disk_;  // unmounted before the folder is removed
 };
 
 // --- An input is never an output ----------------------------------------------------------
@@ -78,11 +72,13 @@ struct InputCase {
 };
 
 const InputCase kInputCases[] = {
-    {"merge_named_tiles", "a.tile_1.vdb", "a.tile_1.vdb", "merge -q DIR/a.tile_1.vdb DIR/a.tile_2.vdb -o DIR/a.tile_1.vdb"},
+    {"merge_named_tiles", "a.tile_1.vdb", "a.tile_1.vdb",
+     "merge -q DIR/a.tile_1.vdb DIR/a.tile_2.vdb -o DIR/a.tile_1.vdb"},
     {"merge_named_link", "a.tile_2.vdb", "m.vdb", "merge -q DIR/a.tile_1.vdb DIR/a.tile_2.vdb -o DIR/m.vdb"},
     {"merge_tiling", "a.tile_1.vdb", "a.vdb", "merge -q --tiles 2x1x1 -o DIR/a.vdb"},
     {"render_params", "p.json", "out.png", "render -q -W 8 -H 8 -p DIR/p.json -o DIR/out.png"},
-    {"render_save_params", "p.json", "p.json", "render -q -W 8 -H 8 -p DIR/p.json -o DIR/o.png --save-params DIR/p.json"},
+    {"render_save_params", "p.json", "p.json",
+     "render -q -W 8 -H 8 -p DIR/p.json -o DIR/o.png --save-params DIR/p.json"},
     {"render_voxels", "a.tile_1.vdb", "out.png", "render -q -W 8 -H 8 --voxels DIR/a.tile_1.vdb -o DIR/out.png"},
     {"povray_scene", "p.json", "scene.pov", "povray -q -p DIR/p.json -o DIR/scene.pov"},
     {"povray_df3", "p.json", "scene.df3", "povray -q --df3 --df3-resolution 8 -p DIR/p.json -o DIR/scene.pov"},
@@ -127,8 +123,9 @@ TEST_P(InputsAreNeverOutputs, RefusedWithAndWithoutForceThroughEveryKindOfName) 
         for (const char* force : {"", " --force"}) {
             const auto result = run(std::string(test.arguments) + force);
             EXPECT_EQ(result.exitCode, 2) << force << ": " << result.err;
-            EXPECT_CONTAINS(result.err, "which this run reads: a run never writes over its own input, not even with "
-                                        "--force; write to another name");
+            EXPECT_CONTAINS(result.err,
+                            "which this run reads: a run never writes over its own input, not even with "
+                            "--force; write to another name");
             EXPECT_CONTAINS(result.err, "'" + input.string() + "'");
             EXPECT_EQ(snapshot(dir_), before) << "files changed";
         }
@@ -149,13 +146,17 @@ struct SetCase {
 };
 
 const SetCase kSetCases[] = {
-    {"povray_df3", "povray -q --df3 --df3-resolution 24 -o OUT/scene.pov",
+    {"povray_df3",
+     "povray -q --df3 --df3-resolution 24 -o OUT/scene.pov",
      {"scene.pov", "scene.df3", "scene_df3.pov", "dqjulia.inc"}},
-    {"render_save_params", "render -q -W 64 -H 48 -o OUT/picture.png --save-params OUT/picture.json",
+    {"render_save_params",
+     "render -q -W 64 -H 48 -o OUT/picture.png --save-params OUT/picture.json",
      {"picture.png", "picture.json"}},
-    {"explore", "explore -q --count 2 --tile-width 32 --tile-height 24 -o OUT",
+    {"explore",
+     "explore -q --count 2 --tile-width 32 --tile-height 24 -o OUT",
      {"sheet.png", "tile_01.png", "tile_01.json", "tile_02.png", "tile_02.json"}},
-    {"farm_slurm_tiles", "farm slurm --frames 1-4 --tiles 2x1x1 -o OUT/job.vdb",
+    {"farm_slurm_tiles",
+     "farm slurm --frames 1-4 --tiles 2x1x1 -o OUT/job.vdb",
      {"job.params.json", "job.slurm", "job.merge.slurm"}},
     {"farm_openjd", "farm openjd --frames 1-4 -o OUT/job.vdb", {"job.params.json", "job.openjd.json"}},
 };
@@ -200,35 +201,36 @@ TEST_P(AllOrNothing, AFullDiskPublishesNothingAndTheRetrySucceeds) {
     std::uintmax_t pages = 0;
     for (const char* name : GetParam().outputs) pages += pagesOf(fs::file_size(roomy / name));
 
-    if (!mountTmpfs("disk", "4m")) GTEST_SKIP() << "cannot mount a tmpfs here: " << std::strerror(errno);
+    const fs::path mount = dir_ / "disk";
+    if (!disk_.emplace(mount, "4m").mounted()) GTEST_SKIP() << "cannot mount a tmpfs here: " << std::strerror(errno);
     auto fill = [&](std::uintmax_t freePages) {
         struct statvfs info {};
-        ASSERT_EQ(::statvfs(mount_.c_str(), &info), 0);
+        ASSERT_EQ(::statvfs(mount.c_str(), &info), 0);
         const std::uintmax_t available = std::uintmax_t(info.f_bavail) * info.f_frsize;
         ASSERT_GT(available, freePages * 4096);
-        write(mount_ / ".filler", std::string(available - freePages * 4096, 'x'));
+        write(mount / ".filler", std::string(available - freePages * 4096, 'x'));
     };
     for (const bool force : {false, true}) {
         SCOPED_TRACE(force ? "--force over old files" : "new files");
-        for (const auto& entry : fs::directory_iterator(mount_)) fs::remove(entry.path());
-        if (force) writeOld(mount_);
+        for (const auto& entry : fs::directory_iterator(mount)) fs::remove(entry.path());
+        if (force) writeOld(mount);
         fill(pages - 1);
-        const auto failed = runInto(mount_, force ? " --force" : "");
+        const auto failed = runInto(mount, force ? " --force" : "");
         EXPECT_EQ(failed.exitCode, 1) << failed.err;
         EXPECT_CONTAINS(failed.err, "No space left on device");
         EXPECT_CONTAINS(failed.err, "(none of the " + std::to_string(GetParam().outputs.size()) +
                                         " files of this run was written)");
         std::set<std::string> left = force ? expected() : std::set<std::string>{};
         left.insert(".filler");
-        EXPECT_EQ(names(mount_), left);
-        if (force) expectOld(mount_);
+        EXPECT_EQ(names(mount), left);
+        if (force) expectOld(mount);
 
-        fs::remove(mount_ / ".filler");  // the space is back: the retry succeeds
-        const auto retry = runInto(mount_, force ? " --force" : "");
+        fs::remove(mount / ".filler");  // the space is back: the retry succeeds
+        const auto retry = runInto(mount, force ? " --force" : "");
         EXPECT_EQ(retry.exitCode, 0) << retry.err;
-        EXPECT_EQ(names(mount_), expected());
+        EXPECT_EQ(names(mount), expected());
         for (const char* name : GetParam().outputs)  // the new files (scripts name their folder: sizes vary)
-            EXPECT_EQ(readFile(mount_ / name).rfind("old ", 0), std::string::npos) << name;
+            EXPECT_EQ(readFile(mount / name).rfind("old ", 0), std::string::npos) << name;
     }
 }
 
@@ -242,10 +244,10 @@ TEST_P(AllOrNothing, AFailureWhilePublishingWithdrawsWhatWasPublished) {
             SCOPED_TRACE("publishing file " + std::to_string(failing + 1) + (force ? ", --force" : ""));
             for (const auto& entry : fs::directory_iterator(folder)) fs::remove(entry.path());
             if (force) writeOld(folder);
-            const auto result = runInto(folder, force ? " --force" : "",
-                                        "LD_PRELOAD='" + std::string(DQJ_FAULT_SHIM) + "' DQJ_FAULT_DIR='" +
-                                            folder.string() + "' DQJ_FAULT_MODE=publish DQJ_FAULT_AFTER=" +
-                                            std::to_string(failing));
+            const auto result =
+                runInto(folder, force ? " --force" : "",
+                        "LD_PRELOAD='" + std::string(DQJ_FAULT_SHIM) + "' DQJ_FAULT_DIR='" + folder.string() +
+                            "' DQJ_FAULT_MODE=publish DQJ_FAULT_AFTER=" + std::to_string(failing));
             EXPECT_EQ(result.exitCode, 1) << result.err;
             EXPECT_CONTAINS(result.err, "Input/output error");
             EXPECT_CONTAINS(result.err, "files of this run was written)");
@@ -368,8 +370,8 @@ TEST_F(Outputs, ANameTooLongForTheFileSystemIsRefusedBeforeTheWorkAndTheLongestI
 // runs it under Wine).
 TEST(WindowsNames, ReservedDeviceNamesInAnyComponentAnyCaseAnyExtension) {
     for (const std::string name :
-         {"CON", "con", "Prn.png", "AUX.tar.gz", "nul", "NUL.vdb", "COM1", "com9.txt", "LPT1", "lpt5.x.y", "COM\xc2\xb9",
-          "lpt\xc2\xb3.png", "CONIN$", "conout$.txt", "NUL .png", "CON  "}) {
+         {"CON", "con", "Prn.png", "AUX.tar.gz", "nul", "NUL.vdb", "COM1", "com9.txt", "LPT1", "lpt5.x.y",
+          "COM\xc2\xb9", "lpt\xc2\xb3.png", "CONIN$", "conout$.txt", "NUL .png", "CON  "}) {
         SCOPED_TRACE(name);
         for (const std::string path : {name, "C:\\renders\\" + name, "Z:/renders/" + name + "/out.png",
                                        "\\\\server\\share\\" + name, "dir/" + name + "/x/out.vdb"})
@@ -379,9 +381,9 @@ TEST(WindowsNames, ReservedDeviceNamesInAnyComponentAnyCaseAnyExtension) {
 }
 
 TEST(WindowsNames, OtherNamesWindowsCannotHold) {
-    for (const std::string path : {"out.png.", "out.png ", "dir./out.png", "dir\\a:b.png", "C:\\x\\a:stream", "what?.png",
-                                   "star*.png", "pipe|.png", "less<.png", "quote\".png", "tab\t.png", "\\\\.\\COM1",
-                                   "//./PhysicalDrive0"})
+    for (const std::string path :
+         {"out.png.", "out.png ", "dir./out.png", "dir\\a:b.png", "C:\\x\\a:stream", "what?.png", "star*.png",
+          "pipe|.png", "less<.png", "quote\".png", "tab\t.png", "\\\\.\\COM1", "//./PhysicalDrive0"})
         EXPECT_NE(dqj::windowsNameProblem(path), "") << path;
     EXPECT_NE(dqj::windowsNameProblem("out.png.").find("would be 'out.png'"), std::string::npos);
 }
