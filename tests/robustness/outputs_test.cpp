@@ -138,7 +138,9 @@ INSTANTIATE_TEST_SUITE_P(Commands, InputsAreNeverOutputs, ::testing::ValuesIn(kI
 
 // --- All or nothing --------------------------------------------------------------------------
 
-/// A command that writes several files into OUT (a folder), and those files.
+/// A command that writes several files into OUT (a folder), and those files. kSetCases holds every
+/// command, in every configuration, whose one output is several files (a frame sequence and the
+/// tiles of a bake are separate outputs instead, each published when done: README).
 struct SetCase {
     const char* name;
     const char* arguments;  // OUT is the output folder
@@ -146,6 +148,7 @@ struct SetCase {
 };
 
 const SetCase kSetCases[] = {
+    {"povray_scene", "povray -q -o OUT/scene.pov", {"scene.pov", "dqjulia.inc"}},
     {"povray_df3",
      "povray -q --df3 --df3-resolution 24 -o OUT/scene.pov",
      {"scene.pov", "scene.df3", "scene_df3.pov", "dqjulia.inc"}},
@@ -155,6 +158,7 @@ const SetCase kSetCases[] = {
     {"explore",
      "explore -q --count 2 --tile-width 32 --tile-height 24 -o OUT",
      {"sheet.png", "tile_01.png", "tile_01.json", "tile_02.png", "tile_02.json"}},
+    {"farm_slurm", "farm slurm --frames 1-4 -o OUT/job.vdb", {"job.params.json", "job.slurm"}},
     {"farm_slurm_tiles",
      "farm slurm --frames 1-4 --tiles 2x1x1 -o OUT/job.vdb",
      {"job.params.json", "job.slurm", "job.merge.slurm"}},
