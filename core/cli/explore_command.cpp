@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <vector>
 
 #include "commands.hpp"
 #include "common.hpp"
@@ -28,6 +29,17 @@ struct ExploreCommandOptions {
     bool quiet = false;
 };
 
+/// The folders a run made for its files (deepest first): removed again, if still empty, unless kept.
+struct MadeFolders {
+    std::vector<std::filesystem::path> paths;
+    bool keep = false;
+    ~MadeFolders() {
+        std::error_code error;
+        if (!keep)
+            for (const std::filesystem::path& path : paths) std::filesystem::remove(path, error);  // empty ones only
+    }
+};
+
 int runExplore(const ExploreCommandOptions& options) {
     Params base = options.fractal.load();
     base.render.width = options.width;
@@ -38,9 +50,26 @@ int runExplore(const ExploreCommandOptions& options) {
     namespace fs = std::filesystem;
     const fs::path folder = pathFromUtf8(options.folder);
     const fs::path sheetPath = folder / "sheet.png";
+    // The folder is checked before it is made (a name Windows cannot hold, a file or a dangling
+    // link in its place); the folders made here are removed again unless the run publishes its files.
+#ifdef _WIN32
+    if (const std::string problem = windowsNameProblem(options.folder); !problem.empty())
+        throw ParamError("output.path", "--output '" + options.folder + "': " + problem);
+#endif
     std::error_code error;
+    if (fs::is_symlink(folder, error) && !fs::exists(folder, error))
+        throw ParamError("output.path", "--output '" + options.folder + "' is a symbolic link to '" +
+                                            utf8FromPath(fs::read_symlink(folder, error)) +
+                                            "', which does not exist; give a folder");
+    if (fs::exists(folder, error) && !fs::is_directory(folder, error))
+        throw ParamError("output.path",
+                         "--output '" + options.folder + "' is a file, not a folder; explore writes a folder of files");
+    MadeFolders made;  // declared before the files: removed after their temporary files
+    for (fs::path at = folder; !at.empty() && !fs::exists(at, error); at = at.parent_path()) made.paths.push_back(at);
     fs::create_directories(folder, error);
-    if (error) throw std::runtime_error("cannot create folder '" + options.folder + "': " + error.message());
+    if (error)
+        throw ParamError("output.path",
+                         "--output '" + options.folder + "': cannot create the folder: " + error.message());
     // The sheet and every tile's picture and parameter file: checked now, published together at the end.
     auto tileName = [](std::size_t index) {
         char name[32];
@@ -82,6 +111,7 @@ int runExplore(const ExploreCommandOptions& options) {
     writeImage(composeSheet(tiles, layout), files.add(utf8FromPath(sheetPath)), ImageFormat::Png8);
     if (interrupted()) throw Cancelled();  // a signal in the last moments of the work: write nothing
     files.commit();
+    made.keep = true;
     if (!options.quiet)
         std::cerr << "wrote " << utf8FromPath(sheetPath) << " and " << tiles.size()
                   << " tiles (tile_NN.png, tile_NN.json) to " << options.folder << "; " << found.skippedEmpty << " of "

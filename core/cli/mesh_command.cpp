@@ -32,6 +32,7 @@ int runMesh(const BakeFlags& flags) {
         paths.push_back(path);
     }
     std::vector<NamedPath> outputs;
+    outputs.reserve(paths.size());
     for (const std::string& path : paths) outputs.push_back({"--output", path});
     checkOutputs(outputs, flags.fractal.inputs(), flags.force);
     const ThreadLimit threads(flags.threadCount());

@@ -186,9 +186,9 @@ std::string randomSuffix() {
 
 /// What is at a path: nothing, a folder, a regular file (with its permission bits) or another kind.
 struct Found {
-    enum Kind { Missing, Folder, Regular, Other, DanglingLink } kind;
-    int mode;
-    std::string linkTarget;  // of a DanglingLink
+    enum Kind { Missing, Folder, Regular, Other, DanglingLink } kind = Missing;
+    int mode = 0;
+    std::string linkTarget = {};  // of a DanglingLink
 };
 
 #ifdef _WIN32
@@ -451,7 +451,7 @@ std::string windowsNameProblem(const std::string& path) {
     for (std::size_t index = first; index < components.size(); ++index) {
         const std::string& name = components[index];
         if (name.empty() || name == "." || name == "..") continue;
-        const std::string problem = windowsComponentProblem(name);
+        std::string problem = windowsComponentProblem(name);
         if (!problem.empty()) return problem;
     }
     return "";

@@ -129,7 +129,7 @@ TEST_F(Messages, EveryTextFlagOfEveryCommandIsEscapedInEveryMessage) {
         std::istringstream split(command);
         for (std::string word; split >> word;) words.push_back(word);
         std::vector<std::string> help = words;
-        help.push_back("--help");
+        help.emplace_back("--help");
         const auto options = textOptions(run(help).out);
         for (const TextOption& option : options) {
             ++flags;

@@ -333,6 +333,38 @@ TEST_F(Outputs, ADanglingLinkIsRefusedBeforeTheWork) {
     }
 }
 
+// explore writes a folder: a dangling link or a file in its place is refused before the work,
+// and a folder it made is removed again when the run fails (here: publishing its files fails).
+TEST_F(Outputs, ExploresFolderIsCheckedBeforeItIsMadeAndRemovedAfterAFailure) {
+    fs::create_symlink(dir_ / "missing", dir_ / "dangling");
+    write(dir_ / "file", "a file");
+    const auto before = snapshot(dir_);
+    for (const char* force : {"", " --force"}) {
+        SCOPED_TRACE(force);
+        auto result = run(std::string("explore -q --count 100 -o DIR/dangling") + force);
+        EXPECT_EQ(result.exitCode, 2) << result.err;
+        EXPECT_CONTAINS(result.err, "--output '" + (dir_ / "dangling").string() + "' is a symbolic link to '" +
+                                        (dir_ / "missing").string() + "', which does not exist; give a folder");
+        result = run(std::string("explore -q --count 100 -o DIR/file") + force);
+        EXPECT_EQ(result.exitCode, 2) << result.err;
+        EXPECT_CONTAINS(result.err, "is a file, not a folder; explore writes a folder of files");
+        EXPECT_EQ(snapshot(dir_), before);
+    }
+    const fs::path fresh = dir_ / "fresh" / "sub";
+    const auto failed =
+        dqj::test::runCommand("/usr/bin/env",
+                              "LD_PRELOAD='" + std::string(DQJ_FAULT_SHIM) + "' DQJ_FAULT_DIR='" + fresh.string() +
+                                  "' DQJ_FAULT_MODE=publish DQJ_FAULT_AFTER=0 '" + DQJ_CLI +
+                                  "' explore -q --count 2 --tile-width 16 --tile-height 16 -o '" + fresh.string() + "'",
+                              dir_);
+    EXPECT_EQ(failed.exitCode, 1) << failed.err;
+    EXPECT_CONTAINS(failed.err, "(none of the 5 files of this run was written)");
+    EXPECT_EQ(snapshot(dir_), before) << "the folders this run made are left";
+    const auto retry = run("explore -q --count 2 --tile-width 16 --tile-height 16 -o DIR/fresh/sub");
+    EXPECT_EQ(retry.exitCode, 0) << retry.err;
+    EXPECT_EQ(dqj::test::fileNames(fresh).size(), 5u);
+}
+
 TEST_F(Outputs, DevicesAreRefusedBeforeTheWork) {
     ASSERT_EQ(run("render -q -W 8 -H 8 -o DIR/pic.png").exitCode, 0);
     ASSERT_EQ(run("bake -q -r 16 --tiles 2x1x1 -o DIR/device.vdb").exitCode, 0);
@@ -377,8 +409,8 @@ TEST(WindowsNames, ReservedDeviceNamesInAnyComponentAnyCaseAnyExtension) {
          {"CON", "con", "Prn.png", "AUX.tar.gz", "nul", "NUL.vdb", "COM1", "com9.txt", "LPT1", "lpt5.x.y",
           "COM\xc2\xb9", "lpt\xc2\xb3.png", "CONIN$", "conout$.txt", "NUL .png", "CON  "}) {
         SCOPED_TRACE(name);
-        for (const std::string path : {name, "C:\\renders\\" + name, "Z:/renders/" + name + "/out.png",
-                                       "\\\\server\\share\\" + name, "dir/" + name + "/x/out.vdb"})
+        for (const std::string& path : {name, "C:\\renders\\" + name, "Z:/renders/" + name + "/out.png",
+                                        "\\\\server\\share\\" + name, "dir/" + name + "/x/out.vdb"})
             EXPECT_NE(dqj::windowsNameProblem(path), "") << path;
     }
     EXPECT_NE(dqj::windowsNameProblem("C:\\dir\\AUX.png").find("reserves for a device"), std::string::npos);

@@ -107,10 +107,24 @@ def check_outputs(work, exe, emulator):
     os.makedirs(folder)
     here = windows_path(folder)
     for name, reason in IMPOSSIBLE:
-        # A render of 1600x1200 takes many seconds under Wine: a refusal after it would show.
-        status, output = run([*emulator, exe, "render", "-q", "-W", "1600", "-H", "1200", "-o", here + "\\" + name])
+        # A render of 1600x1200 takes many seconds under Wine: a refusal after it would show. The
+        # format is given, so that names not ending in .png meet the Windows rule, not the extension's.
+        render = ["render", "-q", "-W", "1600", "-H", "1200", "--format", "png8"]
+        status, output = run([*emulator, exe, *render, "-o", here + "\\" + name])
         checks["%r refused before the work: exit %d %s" % (name, status, output.strip())] = (
             status == 2 and reason in output and not os.listdir(folder)
+        )
+    # The other writers, a reserved name in a folder of the path or in a second output.
+    for arguments in (
+        ["bake", "-q", "-r", "1024", "-o", here + "\\com3\\fractal.vdb"],
+        ["mesh", "-q", "-r", "1024", "-o", here + "\\Nul.x\\fractal.ply"],
+        ["explore", "-q", "--count", "100", "-o", here + "\\lpt1"],
+        ["povray", "-q", "--df3", "--df3-resolution", "512", "-o", here + "\\CON\\scene.pov"],
+        ["render", "-q", "-W", "1600", "-H", "1200", "-o", here + "\\ok.png", "--save-params", here + "\\aux.json"],
+    ):
+        status, output = run([*emulator, exe, *arguments])
+        checks["%s %s refused before the work: exit %d %s" % (arguments[0], arguments[-1], status, output.strip())] = (
+            status == 2 and "reserves for a device" in output and not os.listdir(folder)
         )
     params = os.path.join(folder, "p.json")
     with open(params, "w") as file:
