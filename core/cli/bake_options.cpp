@@ -249,17 +249,6 @@ std::string framePath(const std::string& path, int frame) {
     return path.substr(0, dot) + number + path.substr(dot);
 }
 
-Params paramsAtFrame(const Params& params, int frame) {
-    if (params.animation.empty()) return params;
-    Params result = atFrame(params, frame);
-    try {
-        validate(result);
-    } catch (const ParamError& error) {
-        throw ParamError(error.key(), "at frame " + std::to_string(frame) + ": " + error.what());
-    }
-    return result;
-}
-
 ProgressCallback bakeProgress(ProgressBar& bar, const BakeMonitor& monitor) {
     ProgressCallback draw = bar.callback();
     return [&bar, &monitor, draw](double fraction) {
