@@ -254,8 +254,7 @@ int runSlurm(const FarmFlags& flags) {
     id = id.substr(0, id.find_first_of(";\n"));
     std::cout << "submitted " << script << " as job " << id << "\n";
     if (job.tiling) {
-        std::string merge =
-            runCapturing("sbatch --parsable --dependency=afterok:" + id + " " + shellWord(mergeScript));
+        std::string merge = runCapturing("sbatch --parsable --dependency=afterok:" + id + " " + shellWord(mergeScript));
         merge = merge.substr(0, merge.find_first_of(";\n"));
         std::cout << "submitted " << mergeScript << " as job " << merge << " (after job " << id << ")\n";
     }

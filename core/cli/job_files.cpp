@@ -30,9 +30,11 @@ std::optional<std::vector<std::uint32_t>> decodeUtf8(std::string_view text) {
     std::vector<std::uint32_t> codes;
     for (std::size_t at = 0; at < text.size();) {
         const auto lead = static_cast<unsigned char>(text[at]);
-        const int length = lead < 0x80 ? 1 : lead >= 0xc2 && lead < 0xe0 ? 2 : lead >= 0xe0 && lead < 0xf0 ? 3
-                                         : lead >= 0xf0 && lead < 0xf5    ? 4
-                                                                          : 0;
+        const int length = lead < 0x80                   ? 1
+                           : lead >= 0xc2 && lead < 0xe0 ? 2
+                           : lead >= 0xe0 && lead < 0xf0 ? 3
+                           : lead >= 0xf0 && lead < 0xf5 ? 4
+                                                         : 0;
         if (length == 0 || at + length > text.size()) return std::nullopt;
         std::uint32_t code = length == 1 ? lead : lead & (0x7fu >> length);
         for (int index = 1; index < length; ++index) {

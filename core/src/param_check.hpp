@@ -31,9 +31,11 @@ void checkChoice(const schema::Field& field, const json::Json& value, const std:
 /// checkValue for every key of a whole document, as toJson writes it.
 void checkDocument(const json::Json& document);
 
-/// The rules of validate() that relate values keyframes animate: the bailout at least r_K of the
-/// constant, and the slice 3-D after its rotations. What checkFrames runs at every frame (no
-/// JSON: about a microsecond). Throws ParamError as validate() does.
-void checkAnimatedRules(const Params& params);
+/// The rules of validate() that relate values keyframes animate, what checkFrames runs frame by
+/// frame (no JSON). Each throws ParamError as validate() does.
+/// The bailout at least r_K of the constant (and variant): about 0.2 microseconds.
+void checkBailoutRule(const Params& params);
+/// The slice 3-D after its rotations: about 0.06 microseconds a rotation.
+void checkSliceRule(const Params& params);
 
 }  // namespace dqj::detail

@@ -25,15 +25,19 @@ bool parallel(const glm::dvec3& a, const glm::dvec3& b) {
 
 namespace detail {
 
-void checkAnimatedRules(const Params& params) {
-    auto fail = [](const std::string& key, const std::string& message) { throw ParamError(key, key + ": " + message); };
+void checkBailoutRule(const Params& params) {
     const Fractal& fractal = params.fractal;
     const double needed = minimumBailout(fractal);
     if (!(fractal.bailout >= needed))
-        fail("fractal.bailout", "is " + formatNumber(fractal.bailout) +
-                                    " but must be at least the containment radius r_K = " + formatNumber(needed) +
-                                    " of this constant and variant (points inside r_K may still be in the set)");
+        throw ParamError("fractal.bailout",
+                         "fractal.bailout: is " + formatNumber(fractal.bailout) +
+                             " but must be at least the containment radius r_K = " + formatNumber(needed) +
+                             " of this constant and variant (points inside r_K may still be in "
+                             "the set)");
+}
 
+void checkSliceRule(const Params& params) {
+    auto fail = [](const std::string& key, const std::string& message) { throw ParamError(key, key + ": " + message); };
     const Slice slice = params.slice.effective();
     const Stretch stretch = stretchOf(slice);
     if (stretch.min < 1e-9 * std::max(1.0, stretch.max))
@@ -65,7 +69,8 @@ void validate(const Params& params) {
             fail("slice.rotations", "a rotation plane must name two different axes");
     // Types and ranges: every key against its schema field, as the file's reader checks them.
     detail::checkDocument(json::Json::parse(toJson(params)));
-    detail::checkAnimatedRules(params);
+    detail::checkBailoutRule(params);
+    detail::checkSliceRule(params);
     const Fractal& fractal = params.fractal;
 
     const Camera& camera = params.camera;

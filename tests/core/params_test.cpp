@@ -177,6 +177,33 @@ TEST(Keyframes, ConstantsPeakingBetweenKeysAreFoundAtTheirFrame) {
     EXPECT_EQ(checkFramesRefusal(params, 19, 999999).rfind("at frame 19: ", 0), 0u);
 }
 
+TEST(Keyframes, EachRuleIsCheckedOverItsTracksKeys) {
+    // The constant's keys span frames 10-20, the bailout's 0-30, a rotation's 5-8: checkFrames
+    // applies each rule's tracks only, over their span, and must agree with checking every frame.
+    Fractal small, large;
+    large.c = toDualQuat(Vec8{1.2, 0.9, 0, 0, 0.5, 0, 0, 0});
+    small.c = toDualQuat(Vec8{0.1, 0, 0, 0, 0, 0, 0, 0});
+    for (const double margin : {1.0, 1.3}) {
+        const double first = minimumBailout(small) * 1.01, enough = minimumBailout(large) * margin;
+        char document[1024];
+        std::snprintf(document, sizeof document, R"({"slice": {"rotations": [{"plane": "a.s,b.s", "degrees": 0}]},
+          "animation": {
+          "fractal.c": [{"frame": 10, "value": [0.1, 0, 0, 0, 0, 0, 0, 0]}, {"frame": 20, "value": [1.2, 0.9, 0, 0, 0.5, 0, 0, 0]}],
+          "fractal.bailout": [{"frame": 0, "value": %.17g}, {"frame": 30, "value": %.17g}],
+          "slice.rotations[0].degrees": [{"frame": 5, "value": 0}, {"frame": 8, "value": 90, "interpolation": "smooth"}]}})",
+                      first, first + 1.5 * (enough - first));
+        const Params params = parseParams(document);  // the keys pass
+        EXPECT_EQ(checkFramesRefusal(params, -5, 40), everyFrameRefusal(params, -5, 40)) << margin;
+        EXPECT_EQ(checkFramesRefusal(params, 20, 999999), "");
+    }
+    // Without a track of the constant, r_K stays and a bailout between passing keys passes.
+    const Params bailoutOnly = parseParams(R"({"fractal": {"bailout": 100}, "animation": {
+      "fractal.bailout": [{"frame": 0, "value": 2.1}, {"frame": 30, "value": 90, "interpolation": "smooth"},
+                          {"frame": 60, "value": 3}]}})");
+    EXPECT_EQ(checkFramesRefusal(bailoutOnly, 0, 999999), "");
+    EXPECT_EQ(everyFrameRefusal(bailoutOnly, 0, 70), "");
+}
+
 TEST(Keyframes, CheckFramesAgreesWithEveryFrameOnRandomAnimations) {
     // Random tracks of c and the bailout, linear and smooth, keys at fractional frames too, with
     // the bailout at each key of c just above that key's r_K (so the frames between keys fall on
@@ -184,9 +211,7 @@ TEST(Keyframes, CheckFramesAgreesWithEveryFrameOnRandomAnimations) {
     // range (their keys outside it, so that every key passes): checkFrames must
     // refuse exactly where, and with the message that, checking every frame does.
     std::mt19937_64 random(35);
-    auto uniform = [&](double low, double high) {
-        return low + (high - low) * double(random() >> 11) * 0x1.0p-53;
-    };
+    auto uniform = [&](double low, double high) { return low + (high - low) * double(random() >> 11) * 0x1.0p-53; };
     auto number = [](double value) {
         char text[32];
         std::snprintf(text, sizeof text, "%.17g", value);
@@ -235,9 +260,7 @@ TEST(Keyframes, ValuesBetweenKeysNeverLeaveTheKeys) {
     // The bound checkFrames relies on, in floating point: each value lies between its two keys',
     // for huge and tiny values, uneven spacing, both interpolations.
     std::mt19937_64 random(12);
-    auto uniform = [&](double low, double high) {
-        return low + (high - low) * double(random() >> 11) * 0x1.0p-53;
-    };
+    auto uniform = [&](double low, double high) { return low + (high - low) * double(random() >> 11) * 0x1.0p-53; };
     for (int trial = 0; trial < 200; ++trial) {
         Params params;
         Track track;
@@ -245,8 +268,7 @@ TEST(Keyframes, ValuesBetweenKeysNeverLeaveTheKeys) {
         double frame = 0;
         for (int key = 0; key < 5; ++key) {
             const double value = trial % 2 ? std::pow(10.0, uniform(0, 150)) : uniform(1, 1 + 1e-9);
-            track.keys.push_back(
-                {frame, {value}, random() % 2 ? Interpolation::Smooth : Interpolation::Linear});
+            track.keys.push_back({frame, {value}, random() % 2 ? Interpolation::Smooth : Interpolation::Linear});
             frame += random() % 2 ? uniform(1e-6, 1e-3) : uniform(1, 1e6);
         }
         params.animation = {track};

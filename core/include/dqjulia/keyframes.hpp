@@ -41,8 +41,10 @@ DQJ_API Params stillAtFrame(const Params& params, double frame);
 DQJ_API Params validAtFrame(const Params& params, double frame);
 /// Checks that validAtFrame(params, f) passes for every whole frame f from `first` to `last`, given
 /// that validate(params) has passed; throws the ParamError validAtFrame would for the first
-/// frame that fails. Cost: the keys were checked by validate; here about a microsecond a frame
-/// within the keys' span (a second for a million frames), none outside it or without keys.
+/// frame that fails. Cost: the keys were checked by validate; here, for the frames within the
+/// keys' span, about 0.2 microseconds a frame where the constant is animated and 0.06 a frame for
+/// each rotation of the slice where a rotation is (a million frames: 0.2 s, 2 s with 28 animated
+/// rotations); nothing for the frames outside the span or without keys.
 DQJ_API void checkFrames(const Params& params, int first, int last);
 /// "fractal.c", "fractal.iterations", "fractal.bailout" or "slice.rotations[i].degrees".
 DQJ_API std::string trackKey(const Track& track);
