@@ -28,9 +28,11 @@ struct Job {
 /// --skip-existing, the files that exist are left out (and reported).
 std::vector<Job> plan(const BakeFlags& flags, const Params& params) {
     const std::optional<Tile> tiling = flags.tiling();
+    const FrameRange range = flags.frameRange().value_or(FrameRange{});  // frame 1 without --frames
+    checkFrames(params, range.first, range.last);
     std::vector<Job> jobs;
     for (const auto& [frame, path] : framePaths(flags)) {
-        const Params atFrame = paramsAtFrame(params, frame);
+        const Params atFrame = dqj::atFrame(params, frame);  // valid: checkFrames
         const std::string frameLabel = flags.frameRange() ? "frame " + std::to_string(frame) : "";
         if (!tiling) {
             jobs.push_back({frame, std::nullopt, atFrame, path, frameLabel});

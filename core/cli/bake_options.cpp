@@ -93,8 +93,11 @@ void BakeFlags::addTo(CLI::App& command, BakeCommand kind) {
                         "Half width of the level set's narrow band in voxels (1..32; default 3)")
             ->check(CLI::Range(1.0, 32.0));
     }
-    command.add_option("--frames", frames,
-                       "Keyframed parameters: bake frames FIRST-LAST into NAME_0001.EXT, ... (or one frame)");
+    command.add_option(
+        "--frames", frames,
+        "Keyframed parameters: bake frames FIRST-LAST (0-999999) into NAME_0001.EXT, ... (or one frame); "
+        "every frame's parameters are checked first, a million in about 0.2 s (2 s with 28 "
+        "animated rotations of the slice)");
     if (kind != BakeCommand::Mesh)
         command.add_option("--tiles", tiles,
                            "Bake in AxBxC tiles on the whole bake's grid, into NAME.tile_K.vdb (K from 1, x fastest); "
@@ -247,17 +250,6 @@ std::string framePath(const std::string& path, int frame) {
     char number[16];
     std::snprintf(number, sizeof number, "_%04d", frame);
     return path.substr(0, dot) + number + path.substr(dot);
-}
-
-Params paramsAtFrame(const Params& params, int frame) {
-    if (params.animation.empty()) return params;
-    Params result = atFrame(params, frame);
-    try {
-        validate(result);
-    } catch (const ParamError& error) {
-        throw ParamError(error.key(), "at frame " + std::to_string(frame) + ": " + error.what());
-    }
-    return result;
 }
 
 ProgressCallback bakeProgress(ProgressBar& bar, const BakeMonitor& monitor) {

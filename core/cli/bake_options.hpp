@@ -75,9 +75,6 @@ std::vector<std::pair<int, std::string>> framePaths(const BakeFlags& flags);
 /// The exit codes as a scheduler reads them, for the commands' --help.
 extern const char* const kExitCodesHelp;
 
-/// The parameters at `frame` (keyframes applied), validated; errors name the frame.
-Params paramsAtFrame(const Params& params, int frame);
-
 /// A progress callback that draws the bar with the bake's stage and evaluated/dense counts.
 ProgressCallback bakeProgress(ProgressBar& bar, const BakeMonitor& monitor);
 

@@ -12,7 +12,9 @@
 //           script submitted with --dependency=afterok on the first; --submit submits both.
 //   openjd: an Open Job Description job template (jobtemplate-2023-09): a Bake step whose task
 //           parameters are the frame chunks (and the tiles) and a Merge step depending on it.
-// Cost: writing two or three small files.
+// Every name and path goes into the files through job_files.hpp's writers, quoted for the
+// format's own parser or refused (exit 2) before anything is written.
+// Cost: writing two or three small files; checking the frames (keyframes.hpp's checkFrames).
 #ifdef _WIN32
 #include <windows.h>
 #else
@@ -33,6 +35,7 @@
 #include "dqjulia/dqjulia.h"
 #include "dqjulia/tiles.hpp"
 #include "file_names.hpp"
+#include "job_files.hpp"
 
 namespace dqj::cli {
 namespace {
@@ -58,6 +61,7 @@ struct FarmFlags {
 struct FarmPlan {
     Params params;  // the bake's, flags applied
     std::string dqjulia, paramsPath, output, name;
+    std::string nameFlag;  // where the name came from, for messages
     std::optional<FrameRange> frames;
     int chunk = 1;
     std::optional<Tile> tiling;
@@ -79,13 +83,6 @@ struct FarmPlan {
         return text;
     }
 };
-
-/// `text` in single quotes for sh.
-std::string shellQuote(const std::string& text) {
-    std::string quoted = "'";
-    for (const char ch : text) quoted += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
-    return quoted + "'";
-}
 
 std::string withoutExtension(const std::string& path) {
     return utf8FromPath(pathFromUtf8(path).parent_path() / pathFromUtf8(path).stem());
@@ -128,9 +125,10 @@ FarmPlan plan(const FarmFlags& flags, std::vector<NamedPath> jobFiles) {
         plan.tiling->index = 1;
         checkTile(params, *plan.tiling);
     }
-    for (int frame = plan.frames ? plan.frames->first : 1; frame <= (plan.frames ? plan.frames->last : 1); ++frame)
-        paramsAtFrame(params, frame);  // every frame valid before anything is submitted
+    const FrameRange range = plan.frames.value_or(FrameRange{});
+    checkFrames(params, range.first, range.last);  // every frame valid before anything is submitted
     plan.name = flags.name.empty() ? "dqjulia-" + utf8FromPath(pathFromUtf8(plan.output).stem()) : flags.name;
+    plan.nameFlag = flags.name.empty() ? "--output (its file name names the job: give --name)" : "--name";
     plan.dqjulia = thisExecutable();
     plan.paramsPath = withoutExtension(plan.output) + ".params.json";
     jobFiles.insert(jobFiles.begin(), {"the parameter file", plan.paramsPath});
@@ -139,62 +137,61 @@ FarmPlan plan(const FarmFlags& flags, std::vector<NamedPath> jobFiles) {
 }
 
 /// The shell lines that set $first and $last (the chunk's frames) from a task number.
-std::string chunkLines(const FarmPlan& plan, const std::string& chunkExpression) {
-    if (!plan.frames) return "";
-    std::ostringstream lines;
-    lines << "first=$((" << plan.frames->first << " + (" << chunkExpression << ") * " << plan.chunk << "))\n"
-          << "last=$((first + " << plan.chunk - 1 << "))\n"
-          << "if [ \"$last\" -gt " << plan.frames->last << " ]; then last=" << plan.frames->last << "; fi\n";
-    return lines.str();
+void addChunkLines(SlurmScript& script, const FarmPlan& plan, const std::string& chunkExpression) {
+    if (!plan.frames) return;
+    script.command("first=$((" + std::to_string(plan.frames->first) + " + (" + chunkExpression + ") * " +
+                   std::to_string(plan.chunk) + "))");
+    script.command("last=$((first + " + std::to_string(plan.chunk - 1) + "))");
+    script.command("if [ \"$last\" -gt " + std::to_string(plan.frames->last) +
+                   " ]; then last=" + std::to_string(plan.frames->last) + "; fi");
 }
 
-std::string sbatchHeader(const FarmFlags& flags, const FarmPlan& plan, const std::string& name, int tasks,
+/// The script's comments and #SBATCH lines.
+SlurmScript sbatchHeader(const FarmFlags& flags, const FarmPlan& plan, const std::string& name, int tasks,
                          const std::string& what) {
-    std::ostringstream text;
-    text << "#!/bin/bash\n"
-         << "# " << what << "\n"
-         << "# Written by dqjulia " << dqj_version_string()
-         << " (dqjulia farm slurm). Every machine needs the same dqjulia at the path below and this folder on shared "
-            "storage;\n"
-         << "# submitting again redoes only what is missing (--skip-existing).\n"
-         << "#SBATCH --job-name=" << name << "\n"
-         << "#SBATCH --array=0-" << tasks - 1 << "\n"
-         << "#SBATCH --cpus-per-task=" << flags.cpus << "\n"
-         << "#SBATCH --output=" << withoutExtension(plan.output) << ".slurm-%A_%a.log\n";
-    if (!flags.partition.empty()) text << "#SBATCH --partition=" << flags.partition << "\n";
-    if (!flags.time.empty()) text << "#SBATCH --time=" << flags.time << "\n";
-    if (!flags.memory.empty()) text << "#SBATCH --mem=" << flags.memory << "\n";
-    for (const std::string& option : flags.sbatchOptions) text << "#SBATCH " << option << "\n";
-    text << "set -eu\n";
-    return text.str();
+    SlurmScript script;
+    script.comment(what);
+    script.comment(std::string("Written by dqjulia ") + dqj_version_string() +
+                   " (dqjulia farm slurm). Every machine needs the same dqjulia at the path below and this folder "
+                   "on shared storage;");
+    script.comment("submitting again redoes only what is missing (--skip-existing).");
+    script.directive("--job-name", name, plan.nameFlag);
+    script.directive("--array", "0-" + std::to_string(tasks - 1), "--frames");
+    script.directive("--cpus-per-task", std::to_string(flags.cpus), "--cpus-per-task");
+    script.directive("--output", SlurmScript::logPattern(withoutExtension(plan.output), ".slurm-%A_%a.log", "--output"),
+                     "--output");
+    if (!flags.partition.empty()) script.directive("--partition", flags.partition, "--partition");
+    if (!flags.time.empty()) script.directive("--time", flags.time, "--time");
+    if (!flags.memory.empty()) script.directive("--mem", flags.memory, "--mem");
+    for (const std::string& option : flags.sbatchOptions) script.argument(option, "--sbatch");
+    script.command("set -eu");
+    return script;
 }
 
 std::string slurmBakeScript(const FarmFlags& flags, const FarmPlan& plan) {
-    std::ostringstream text;
     const int tasks = plan.chunks() * plan.tiles();
-    text << sbatchHeader(flags, plan, plan.name, tasks,
-                         "Bakes " + plan.describe() + ": " + std::to_string(tasks) + " array tasks.");
-    text << chunkLines(plan,
-                       plan.tiling ? "SLURM_ARRAY_TASK_ID / " + std::to_string(plan.tiles()) : "SLURM_ARRAY_TASK_ID");
-    text << "exec " << shellQuote(plan.dqjulia) << " bake -p " << shellQuote(plan.paramsPath);
-    if (plan.frames) text << " --frames \"$first-$last\"";
+    SlurmScript script = sbatchHeader(flags, plan, plan.name, tasks,
+                                      "Bakes " + plan.describe() + ": " + std::to_string(tasks) + " array tasks.");
+    addChunkLines(script, plan,
+                  plan.tiling ? "SLURM_ARRAY_TASK_ID / " + std::to_string(plan.tiles()) : "SLURM_ARRAY_TASK_ID");
+    std::string line = "exec " + shellWord(plan.dqjulia) + " bake -p " + shellWord(plan.paramsPath);
+    if (plan.frames) line += " --frames \"$first-$last\"";
     if (plan.tiling)
-        text << " --tiles " << tilingText(*plan.tiling) << " --tile $((SLURM_ARRAY_TASK_ID % " << plan.tiles()
-             << " + 1))";
-    text << " -o " << shellQuote(plan.output) << " --skip-existing\n";
-    return text.str();
+        line += " --tiles " + tilingText(*plan.tiling) + " --tile $((SLURM_ARRAY_TASK_ID % " +
+                std::to_string(plan.tiles()) + " + 1))";
+    script.command(line + " -o " + shellWord(plan.output) + " --skip-existing");
+    return script.text();
 }
 
 std::string slurmMergeScript(const FarmFlags& flags, const FarmPlan& plan) {
-    std::ostringstream text;
-    text << sbatchHeader(flags, plan, plan.name + "-merge", plan.chunks(),
-                         "Merges the tiles of " + plan.describe() + ": " + std::to_string(plan.chunks()) +
-                             " array tasks, after the bake's (--dependency=afterok).");
-    text << chunkLines(plan, "SLURM_ARRAY_TASK_ID");
-    text << "exec " << shellQuote(plan.dqjulia) << " merge --tiles " << tilingText(*plan.tiling);
-    if (plan.frames) text << " --frames \"$first-$last\"";
-    text << " -o " << shellQuote(plan.output) << " --skip-existing\n";
-    return text.str();
+    SlurmScript script = sbatchHeader(flags, plan, plan.name + "-merge", plan.chunks(),
+                                      "Merges the tiles of " + plan.describe() + ": " + std::to_string(plan.chunks()) +
+                                          " array tasks, after the bake's (--dependency=afterok).");
+    addChunkLines(script, plan, "SLURM_ARRAY_TASK_ID");
+    std::string line = "exec " + shellWord(plan.dqjulia) + " merge --tiles " + tilingText(*plan.tiling);
+    if (plan.frames) line += " --frames \"$first-$last\"";
+    script.command(line + " -o " + shellWord(plan.output) + " --skip-existing");
+    return script.text();
 }
 
 /// Runs `command` through sh; its standard output. Throws std::runtime_error when it fails.
@@ -228,23 +225,27 @@ int runSlurm(const FarmFlags& flags) {
     std::vector<NamedPath> jobFiles{{"--script", script}};
     if (!flags.bake.tiles.empty()) jobFiles.push_back({"the merge script", mergeScript});
     FarmPlan job = plan(flags, jobFiles);
+    SlurmScript::checkJobName(job.name + (job.tiling ? "-merge" : ""), job.nameFlag);
+    // Every text before the first file, so a value the format cannot carry leaves nothing behind.
+    const std::string bakeText = slurmBakeScript(flags, job);
+    const std::string mergeText = job.tiling ? slurmMergeScript(flags, job) : "";
     if (job.chunks() * job.tiles() > kSlurmMaxArraySize)
         std::cerr << "dqjulia farm slurm: warning: " << job.chunks() * job.tiles()
                   << " array tasks: more than Slurm's default MaxArraySize allows (" << kSlurmMaxArraySize
                   << "); raise --chunk, or the cluster's MaxArraySize\n";
     AtomicFileSet files(existingPolicy(flags.bake.force));  // all of them or none
     files.add(job.paramsPath).stream() << toJson(job.params);
-    files.add(script).stream() << slurmBakeScript(flags, job);
-    if (job.tiling) files.add(mergeScript).stream() << slurmMergeScript(flags, job);
+    files.add(script).stream() << bakeText;
+    if (job.tiling) files.add(mergeScript).stream() << mergeText;
     files.commit();
     std::cerr << "wrote " << job.paramsPath << ", " << script << (job.tiling ? " and " + mergeScript : "") << " ("
               << job.describe() << ")\n";
-    const std::string submitBake = "sbatch --parsable " + shellQuote(script);
+    const std::string submitBake = "sbatch --parsable " + shellWord(script);
     if (!flags.submit) {
         std::cout << "submit with:\n  ";
         if (job.tiling)
             std::cout << "job=$(" << submitBake << ") && sbatch --dependency=afterok:${job%%;*} "
-                      << shellQuote(mergeScript) << "\n";
+                      << shellWord(mergeScript) << "\n";
         else
             std::cout << submitBake << "\n";
         std::cout << "(or add --submit)\n";
@@ -254,8 +255,7 @@ int runSlurm(const FarmFlags& flags) {
     id = id.substr(0, id.find_first_of(";\n"));
     std::cout << "submitted " << script << " as job " << id << "\n";
     if (job.tiling) {
-        std::string merge =
-            runCapturing("sbatch --parsable --dependency=afterok:" + id + " " + shellQuote(mergeScript));
+        std::string merge = runCapturing("sbatch --parsable --dependency=afterok:" + id + " " + shellWord(mergeScript));
         merge = merge.substr(0, merge.find_first_of(";\n"));
         std::cout << "submitted " << mergeScript << " as job " << merge << " (after job " << id << ")\n";
     }
@@ -300,9 +300,15 @@ int runOpenJd(const FarmFlags& flags) {
                                        " chunks of frames: an Open Job Description task "
                                        "parameter holds at most " +
                                        std::to_string(kMaxOpenJdChunks) + " values; raise --chunk");
+    // Names and paths are job parameters' values, never format-string text (job_files.hpp).
+    const std::string name =
+        OpenJd::jobName(flags.name.empty() ? OpenJd::shortenedName(job.name) : job.name, job.nameFlag);
+    const std::string dqjulia = OpenJd::parameterValue(job.dqjulia, "this dqjulia's path");
+    const std::string params = OpenJd::parameterValue(relativeTo(job.paramsPath, file), "the parameter file's path");
+    const std::string output = OpenJd::parameterValue(relativeTo(job.output, file), "--output");
     nlohmann::ordered_json document = {
         {"specificationVersion", "jobtemplate-2023-09"},
-        {"name", job.name},
+        {"name", "{{Param.JobName}}"},
         {"description", "Bakes " + job.describe() + " with dqjulia " + dqj_version_string() +
                             " (dqjulia farm openjd); every task skips the files that exist"},
         // A PATH parameter's default is relative to the template's folder (and mapped between
@@ -310,29 +316,36 @@ int runOpenJd(const FarmFlags& flags) {
         {"parameterDefinitions",
          {{{"name", "Dqjulia"},
            {"type", "STRING"},
-           {"default", job.dqjulia},
+           {"default", dqjulia},
            {"description", "The dqjulia command, the same version on every machine"}},
           {{"name", "Params"},
            {"type", "PATH"},
            {"objectType", "FILE"},
            {"dataFlow", "IN"},
-           {"default", relativeTo(job.paramsPath, file)},
+           {"default", params},
            {"description", "The complete parameter file of the bake"}},
           {{"name", "Output"},
            {"type", "PATH"},
            {"objectType", "FILE"},
            {"dataFlow", "OUT"},
-           {"default", relativeTo(job.output, file)},
-           {"description", "The bake's output (frames: NAME_0001.vdb, ...), on shared storage"}}}},
+           {"default", output},
+           {"description", "The bake's output (frames: NAME_0001.vdb, ...), on shared storage"}},
+          {{"name", "JobName"},
+           {"type", "STRING"},
+           {"minLength", 1},
+           {"maxLength", OpenJd::kMaxNameCharacters},
+           {"default", name},
+           {"description", "The job's name"}}}},
         {"steps", nlohmann::ordered_json::array({openJdStep("Bake", job, false)})}};
     if (job.tiling) document["steps"].push_back(openJdStep("Merge", job, true));
+    const std::string text = document.dump(2) + "\n";
     AtomicFileSet files(existingPolicy(flags.bake.force));  // both or neither
     files.add(job.paramsPath).stream() << toJson(job.params);
-    files.add(file).stream() << document.dump(2) << "\n";
+    files.add(file).stream() << text;
     files.commit();
     std::cerr << "wrote " << job.paramsPath << " and " << file << " (" << job.describe() << ")\n";
-    std::cout << "check and run it locally with:\n  openjd check " << shellQuote(file) << "\n  openjd run "
-              << shellQuote(file) << (job.tiling ? " --step Merge --run-dependencies" : " --step Bake") << "\n"
+    std::cout << "check and run it locally with:\n  openjd check " << shellWord(file) << "\n  openjd run "
+              << shellWord(file) << (job.tiling ? " --step Merge --run-dependencies" : " --step Bake") << "\n"
               << "or submit it to a farm that runs Open Job Description (AWS Deadline Cloud: deadline bundle submit)\n";
     return kSuccess;
 }
@@ -341,7 +354,8 @@ void addCommonFlags(CLI::App& command, FarmFlags& flags) {
     flags.bake.addTo(command, BakeCommand::Farm);
     command.add_option("--chunk", flags.chunk, "Frames a task bakes, one after another (default 1)")
         ->check(CLI::Range(1, 1000000));
-    command.add_option("--name", flags.name, "The job's name (default: dqjulia-NAME)");
+    command.add_option("--name", flags.name,
+                       "The job's name (default: dqjulia-NAME; Open Job Description keeps 128 characters of it)");
 }
 
 }  // namespace
@@ -364,7 +378,7 @@ Runner addFarmCommand(CLI::App& app) {
     slurmCommand->add_option("--time", slurm->time, "sbatch --time, a task's time limit");
     slurmCommand->add_option("--mem", slurm->memory, "sbatch --mem, a task's memory");
     slurmCommand->add_option("--sbatch", slurm->sbatchOptions,
-                             "Another #SBATCH line, e.g. --sbatch=--qos=low (repeatable)");
+                             "Another #SBATCH line: one sbatch option a flag, e.g. --sbatch=--qos=low (repeatable)");
     slurmCommand->add_flag("--submit", slurm->submit, "Submit the job(s) with sbatch");
     CLI::App* openjdCommand = farm->add_subcommand(
         "openjd", "An Open Job Description job template: frame chunks as a task parameter, tiles and a merge step");

@@ -25,10 +25,12 @@ int runMesh(const BakeFlags& flags) {
     std::vector<int> frames;
     std::vector<Params> perFrame;
     std::vector<std::string> paths;
+    const FrameRange range = flags.frameRange().value_or(FrameRange{});  // frame 1 without --frames
+    checkFrames(params, range.first, range.last);
     for (const auto& [frame, path] : framePaths(flags)) {
         if (flags.skips(path)) continue;
         frames.push_back(frame);
-        perFrame.push_back(paramsAtFrame(params, frame));
+        perFrame.push_back(atFrame(params, frame));  // valid: checkFrames
         paths.push_back(path);
     }
     std::vector<NamedPath> outputs;

@@ -167,12 +167,7 @@ void fillSample(const dqj::Escape& escape, dqj_sample& sample) {
 }
 
 /// The context's parameters at its frame (keyframes applied), validated.
-dqj::Params paramsNow(const dqj_context_t& context) {
-    if (context.params.animation.empty()) return context.params;
-    dqj::Params params = dqj::atFrame(context.params, context.frame);
-    dqj::validate(params);
-    return params;
-}
+dqj::Params paramsNow(const dqj_context_t& context) { return dqj::validAtFrame(context.params, context.frame); }
 
 /// Runs a bake step that writes a file: I/O failures (std::runtime_error that is neither a
 /// parameter problem nor a cancel) become DQJ_ERROR_IO.

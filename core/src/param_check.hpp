@@ -1,11 +1,16 @@
 // param_check.hpp - a JSON value checked against its schema field (internal): the one place a
-// parameter's type and range are enforced, by the file's reader and by validate() alike.
+// parameter's type and range are enforced, by the file's reader and by validate() alike; and the
+// rules between the values keyframes animate.
 #pragma once
 
 #include <string>
 
 #include "dqjulia/schema.hpp"
 #include "json_text.hpp"
+
+namespace dqj {
+struct Params;
+}
 
 namespace dqj::detail {
 
@@ -25,5 +30,12 @@ void checkChoice(const schema::Field& field, const json::Json& value, const std:
 
 /// checkValue for every key of a whole document, as toJson writes it.
 void checkDocument(const json::Json& document);
+
+/// The rules of validate() that relate values keyframes animate, what checkFrames runs frame by
+/// frame (no JSON). Each throws ParamError as validate() does.
+/// The bailout at least r_K of the constant (and variant): about 0.2 microseconds.
+void checkBailoutRule(const Params& params);
+/// The slice 3-D after its rotations: about 0.06 microseconds a rotation.
+void checkSliceRule(const Params& params);
 
 }  // namespace dqj::detail

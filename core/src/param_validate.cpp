@@ -23,9 +23,45 @@ bool parallel(const glm::dvec3& a, const glm::dvec3& b) {
 
 }  // namespace
 
+namespace detail {
+
+void checkBailoutRule(const Params& params) {
+    const Fractal& fractal = params.fractal;
+    const double needed = minimumBailout(fractal);
+    if (!(fractal.bailout >= needed))
+        throw ParamError("fractal.bailout",
+                         "fractal.bailout: is " + formatNumber(fractal.bailout) +
+                             " but must be at least the containment radius r_K = " + formatNumber(needed) +
+                             " of this constant and variant (points inside r_K may still be in "
+                             "the set)");
+}
+
+void checkSliceRule(const Params& params) {
+    auto fail = [](const std::string& key, const std::string& message) { throw ParamError(key, key + ": " + message); };
+    const Slice slice = params.slice.effective();
+    const Stretch stretch = stretchOf(slice);
+    if (stretch.min < 1e-9 * std::max(1.0, stretch.max))
+        fail("slice.axes", "the three axes are zero or parallel, so the slice is not 3-D; give three independent axes");
+    // Linearly dependent axes (z = x + y) span a plane: the Gram determinant vanishes against
+    // the product of the squared lengths (Hadamard's bound; 1 for orthogonal axes).
+    double gram[3][3] = {};
+    for (int row = 0; row < 3; ++row)
+        for (int column = 0; column < 3; ++column)
+            for (int index = 0; index < 8; ++index)
+                gram[row][column] += slice.axes[row][index] * slice.axes[column][index];
+    const double determinant = gram[0][0] * (gram[1][1] * gram[2][2] - gram[1][2] * gram[2][1]) -
+                               gram[0][1] * (gram[1][0] * gram[2][2] - gram[1][2] * gram[2][0]) +
+                               gram[0][2] * (gram[1][0] * gram[2][1] - gram[1][1] * gram[2][0]);
+    if (!(determinant > 1e-10 * gram[0][0] * gram[1][1] * gram[2][2]))
+        fail("slice.axes",
+             "the three axes are linearly dependent (one is a combination of the others), so the slice "
+             "is a plane, not 3-D; give three independent axes");
+}
+
+}  // namespace detail
+
 void validate(const Params& params) {
     auto fail = [](const std::string& key, const std::string& message) { throw ParamError(key, key + ": " + message); };
-    const Fractal& fractal = params.fractal;
     // What passes (from flags or the C ABI) is written by --save-params as a file that reads back.
     for (const PlaneRotation& rotation : params.slice.rotations)
         if (rotation.first == rotation.second || rotation.first < 0 || rotation.first > 7 || rotation.second < 0 ||
@@ -33,32 +69,9 @@ void validate(const Params& params) {
             fail("slice.rotations", "a rotation plane must name two different axes");
     // Types and ranges: every key against its schema field, as the file's reader checks them.
     detail::checkDocument(json::Json::parse(toJson(params)));
-    const double needed = minimumBailout(fractal);
-    if (!(fractal.bailout >= needed))
-        fail("fractal.bailout", "is " + formatNumber(fractal.bailout) +
-                                    " but must be at least the containment radius r_K = " + formatNumber(needed) +
-                                    " of this constant and variant (points inside r_K may still be in the set)");
-
-    const Slice slice = params.slice.effective();
-    const Stretch stretch = stretchOf(slice);
-    if (stretch.min < 1e-9 * std::max(1.0, stretch.max))
-        fail("slice.axes", "the three axes are zero or parallel, so the slice is not 3-D; give three independent axes");
-    // Linearly dependent axes (z = x + y) span a plane: the Gram determinant vanishes against
-    // the product of the squared lengths (Hadamard's bound; 1 for orthogonal axes).
-    {
-        double gram[3][3] = {};
-        for (int row = 0; row < 3; ++row)
-            for (int column = 0; column < 3; ++column)
-                for (int index = 0; index < 8; ++index)
-                    gram[row][column] += slice.axes[row][index] * slice.axes[column][index];
-        const double determinant = gram[0][0] * (gram[1][1] * gram[2][2] - gram[1][2] * gram[2][1]) -
-                                   gram[0][1] * (gram[1][0] * gram[2][2] - gram[1][2] * gram[2][0]) +
-                                   gram[0][2] * (gram[1][0] * gram[2][1] - gram[1][1] * gram[2][0]);
-        if (!(determinant > 1e-10 * gram[0][0] * gram[1][1] * gram[2][2]))
-            fail("slice.axes",
-                 "the three axes are linearly dependent (one is a combination of the others), so the slice "
-                 "is a plane, not 3-D; give three independent axes");
-    }
+    detail::checkBailoutRule(params);
+    detail::checkSliceRule(params);
+    const Fractal& fractal = params.fractal;
 
     const Camera& camera = params.camera;
     if (glm::length(camera.up) == 0.0) fail("camera.up", "must not be the zero vector");
@@ -102,15 +115,14 @@ void validate(const Params& params) {
                 fail("bake.bounds", "min must be below max on every axis (x, y, z)");
 
     // Keyframes: a rotation track needs its rotation, and the parameters at every key must pass
-    // the rules above (the frames between keys are checked when they are baked).
+    // the rules above (checkFrames, keyframes.cpp, checks the frames between keys).
     for (const Track& track : params.animation) {
         if (track.target == AnimatedValue::RotationDegrees && track.rotation >= int(params.slice.rotations.size()))
             fail("animation." + trackKey(track),
                  "animates rotation " + std::to_string(track.rotation) + " but slice.rotations has " +
                      std::to_string(params.slice.rotations.size()) + " (they count from 0)");
         for (const Keyframe& key : track.keys) {
-            Params still = atFrame(params, key.frame);
-            still.animation.clear();
+            const Params still = stillAtFrame(params, key.frame);
             try {
                 validate(still);
             } catch (const ParamError& error) {

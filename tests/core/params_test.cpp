@@ -2,7 +2,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <random>
+#include <string>
 
+#include "dqjulia/estimate.hpp"
 #include "dqjulia/params.hpp"
 
 namespace dqj {
@@ -130,6 +134,155 @@ TEST(Params, TypesOnlyDefersCrossFieldRules) {
     Params params = parseParams(json, "x", Validation::TypesOnly);
     params.fractal.bailout = 8.0;
     EXPECT_NO_THROW(validate(params));
+}
+
+// --- Keyframes: checkFrames finds what checking every frame finds ----------------------------
+
+/// The message validAtFrame gives at the first frame of [first, last] it refuses, or "".
+std::string everyFrameRefusal(const Params& params, int first, int last) {
+    for (int frame = first; frame <= last; ++frame) {
+        try {
+            validAtFrame(params, frame);
+        } catch (const ParamError& error) {
+            return error.what();
+        }
+    }
+    return "";
+}
+
+std::string checkFramesRefusal(const Params& params, int first, int last) {
+    try {
+        checkFrames(params, first, last);
+    } catch (const ParamError& error) {
+        return error.what();
+    }
+    return "";
+}
+
+TEST(Keyframes, ConstantsPeakingBetweenKeysAreFoundAtTheirFrame) {
+    // Two smooth components of c, each monotone, peak together between frames 10 and 20: |c|
+    // there exceeds every key's, and the bailout, enough for the keys, is too small.
+    const Params params = parseParams(R"({"fractal": {"c": [1, 0, 0, 0, 0, 0, 0, 0], "bailout": 10}, "animation": {
+      "fractal.c": [{"frame": 9, "value": [1, -1, 0, 0, 0, 0, 0, 0], "interpolation": "smooth"},
+                    {"frame": 10, "value": [1, 0, 0, 0, 0, 0, 0, 0], "interpolation": "smooth"},
+                    {"frame": 20, "value": [0, 1, 0, 0, 0, 0, 0, 0], "interpolation": "smooth"},
+                    {"frame": 21, "value": [-1, 1, 0, 0, 0, 0, 0, 0]}],
+      "fractal.bailout": [{"frame": 9, "value": 10}, {"frame": 10, "value": 1.62},
+                          {"frame": 20, "value": 1.62}, {"frame": 21, "value": 10}]}})");
+    const std::string refusal = checkFramesRefusal(params, 1, 30);
+    EXPECT_EQ(refusal, everyFrameRefusal(params, 1, 30));
+    EXPECT_EQ(refusal.rfind("at frame 11: fractal.bailout: is 1.62 but must be at least", 0), 0u) << refusal;
+    EXPECT_EQ(checkFramesRefusal(params, 1, 10), "");  // no whole frame between the keys
+    EXPECT_EQ(checkFramesRefusal(params, 21, 999999), "");
+    EXPECT_EQ(checkFramesRefusal(params, 19, 999999).rfind("at frame 19: ", 0), 0u);
+}
+
+TEST(Keyframes, EachRuleIsCheckedOverItsTracksKeys) {
+    // The constant's keys span frames 10-20, the bailout's 0-30, a rotation's 5-8: checkFrames
+    // applies each rule's tracks only, over their span, and must agree with checking every frame.
+    Fractal small, large;
+    large.c = toDualQuat(Vec8{1.2, 0.9, 0, 0, 0.5, 0, 0, 0});
+    small.c = toDualQuat(Vec8{0.1, 0, 0, 0, 0, 0, 0, 0});
+    for (const double margin : {1.0, 1.3}) {
+        const double first = minimumBailout(small) * 1.01, enough = minimumBailout(large) * margin;
+        char document[1024];
+        std::snprintf(document, sizeof document, R"({"slice": {"rotations": [{"plane": "a.s,b.s", "degrees": 0}]},
+          "animation": {
+          "fractal.c": [{"frame": 10, "value": [0.1, 0, 0, 0, 0, 0, 0, 0]}, {"frame": 20, "value": [1.2, 0.9, 0, 0, 0.5, 0, 0, 0]}],
+          "fractal.bailout": [{"frame": 0, "value": %.17g}, {"frame": 30, "value": %.17g}],
+          "slice.rotations[0].degrees": [{"frame": 5, "value": 0}, {"frame": 8, "value": 90, "interpolation": "smooth"}]}})",
+                      first, first + 1.5 * (enough - first));
+        const Params params = parseParams(document);  // the keys pass
+        EXPECT_EQ(checkFramesRefusal(params, -5, 40), everyFrameRefusal(params, -5, 40)) << margin;
+        EXPECT_EQ(checkFramesRefusal(params, 20, 999999), "");
+    }
+    // Without a track of the constant, r_K stays and a bailout between passing keys passes.
+    const Params bailoutOnly = parseParams(R"({"fractal": {"bailout": 100}, "animation": {
+      "fractal.bailout": [{"frame": 0, "value": 2.1}, {"frame": 30, "value": 90, "interpolation": "smooth"},
+                          {"frame": 60, "value": 3}]}})");
+    EXPECT_EQ(checkFramesRefusal(bailoutOnly, 0, 999999), "");
+    EXPECT_EQ(everyFrameRefusal(bailoutOnly, 0, 70), "");
+}
+
+TEST(Keyframes, CheckFramesAgreesWithEveryFrameOnRandomAnimations) {
+    // Random tracks of c and the bailout, linear and smooth, keys at fractional frames too, with
+    // the bailout at each key of c just above that key's r_K (so the frames between keys fall on
+    // either side of the rule), and a rotation and an iteration count animated across the whole
+    // range (their keys outside it, so that every key passes): checkFrames must
+    // refuse exactly where, and with the message that, checking every frame does.
+    std::mt19937_64 random(35);
+    auto uniform = [&](double low, double high) { return low + (high - low) * double(random() >> 11) * 0x1.0p-53; };
+    auto number = [](double value) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.17g", value);
+        return std::string(text);
+    };
+    auto interpolation = [&] { return random() % 2 ? ", \"interpolation\": \"smooth\"}" : "}"; };
+    int compared = 0, refused = 0;
+    for (int trial = 0; trial < 120; ++trial) {
+        const bool coupled = random() % 2;
+        std::string c = "[", bailout = "[";
+        double frame = uniform(-2, 4);
+        for (int key = 0, keys = 2 + int(random() % 3); key < keys; ++key) {
+            Vec8 value{};
+            for (const int k : {0, 1, 2, 4}) value[k] = uniform(-1.5, 1.5);
+            Fractal fractal;
+            fractal.c = toDualQuat(value);
+            fractal.variant = coupled ? Variant::PaperCoupled : Variant::Paper;
+            std::string components;
+            for (int k = 0; k < 8; ++k) components += (k ? ", " : "") + number(value[k]);
+            const std::string separator = key ? ", " : "";
+            c += separator + "{\"frame\": " + number(frame) + ", \"value\": [" + components + "]" + interpolation();
+            bailout += separator + "{\"frame\": " + number(frame) +
+                       ", \"value\": " + number(minimumBailout(fractal) * uniform(1.0, 1.005)) + interpolation();
+            frame += random() % 3 ? std::floor(uniform(1, 12)) : uniform(0.3, 12);
+        }
+        const std::string document =
+            R"({"fractal": {"variant": ")" + std::string(coupled ? "paper-coupled" : "paper") +
+            R"(", "bailout": 40}, "slice": {"axes": "a.s,a.i,b.s", "rotations": [{"plane": "b.s,a.j", "degrees": 0}]},
+              "animation": {"fractal.c": )" +
+            c + "], \"fractal.bailout\": " + bailout + R"(],
+                "slice.rotations[0].degrees": [{"frame": -30, "value": -30, "interpolation": "smooth"},
+                                               {"frame": 60, "value": 400}],
+                "fractal.iterations": [{"frame": -10, "value": 3}, {"frame": 50, "value": 20}]}})";
+        const Params params = parseParams(document);  // the keys pass by construction
+        const std::string expected = everyFrameRefusal(params, -2, 30);
+        EXPECT_EQ(checkFramesRefusal(params, -2, 30), expected) << document;
+        ++compared;
+        refused += !expected.empty();
+    }
+    // Both outcomes happen often enough for the comparison to mean something.
+    EXPECT_GT(refused, 20) << compared;
+    EXPECT_GT(compared - refused, 20);
+}
+
+TEST(Keyframes, ValuesBetweenKeysNeverLeaveTheKeys) {
+    // The bound checkFrames relies on, in floating point: each value lies between its two keys',
+    // for huge and tiny values, uneven spacing, both interpolations.
+    std::mt19937_64 random(12);
+    auto uniform = [&](double low, double high) { return low + (high - low) * double(random() >> 11) * 0x1.0p-53; };
+    for (int trial = 0; trial < 200; ++trial) {
+        Params params;
+        Track track;
+        track.target = AnimatedValue::Bailout;
+        double frame = 0;
+        for (int key = 0; key < 5; ++key) {
+            const double value = trial % 2 ? std::pow(10.0, uniform(0, 150)) : uniform(1, 1 + 1e-9);
+            track.keys.push_back({frame, {value}, random() % 2 ? Interpolation::Smooth : Interpolation::Linear});
+            frame += random() % 2 ? uniform(1e-6, 1e-3) : uniform(1, 1e6);
+        }
+        params.animation = {track};
+        for (std::size_t key = 0; key + 1 < track.keys.size(); ++key) {
+            const double from = track.keys[key].frame, to = track.keys[key + 1].frame;
+            const double low = std::min(track.keys[key].value[0], track.keys[key + 1].value[0]);
+            const double high = std::max(track.keys[key].value[0], track.keys[key + 1].value[0]);
+            for (int step = 0; step <= 64; ++step) {
+                const double value = atFrame(params, from + (to - from) * step / 64).fractal.bailout;
+                ASSERT_GE(value, low) << trial << " " << key << " " << step;
+                ASSERT_LE(value, high) << trial << " " << key << " " << step;
+            }
+        }
+    }
 }
 
 }  // namespace

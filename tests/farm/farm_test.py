@@ -174,14 +174,19 @@ def test_openjd(args):
     )
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def engine_arguments(description):
+    """The command line of the farm tests: the engine, dqjulia, a work folder and the engine's tools."""
+    parser = argparse.ArgumentParser(description=description)
     parser.add_argument("engine", choices=("slurm", "openjd"))
     parser.add_argument("--cli", required=True)
     parser.add_argument("--work", required=True)
     parser.add_argument("--cluster", help="scripts/slurm-local.sh")
     parser.add_argument("--openjd", help="the openjd command (scripts/tool-env.sh openjd --print)")
-    args = parser.parse_args()
+    return parser
+
+
+def main():
+    args = engine_arguments(__doc__.splitlines()[0]).parse_args()
     (test_slurm if args.engine == "slurm" else test_openjd)(args)
     print("%s passed" % args.engine)
 

@@ -368,6 +368,114 @@ TEST_F(Hostile, Df3SceneNamesPovrayCannotCarryAreRefused) {
     EXPECT_EQ(run("povray -q --df3 --df3-resolution 8 -o " + path("plain name.pov")).exitCode, 0);
 }
 
+// --- Farm job files: names each format cannot carry, and the cost of a keyframed range -----
+
+/// `text` in single quotes for sh.
+std::string shellWord(const std::string& text) {
+    std::string quoted = "'";
+    for (const char ch : text) quoted += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+    return quoted + "'";
+}
+
+TEST_F(Hostile, JobFilesRefuseWhatTheirFormatCannotCarry) {
+    fs::create_directories(dir_ / "back\\slash");
+    struct Case {
+        std::string arguments, message;
+    };
+    const std::string plain = " -r 24 -o " + shellWord((dir_ / "job.vdb").string());
+    const std::vector<Case> cases{
+        // sbatch reads a directive to the end of its line: the rest would be a command.
+        {"farm slurm -r 24 -o " + shellWord((dir_ / "a\ntouch INJECTED\n.vdb").string()),
+         "a line break (U+000A) at byte"},
+        {"farm slurm --name " + shellWord("job\necho INJECTED") + plain, "--name: a line break (U+000A) at byte 4"},
+        {"farm slurm --partition " + shellWord("x\ny") + plain, "--partition: a line break"},
+        // A backslash turns Slurm's %A_%a off in the log's name (and is dropped).
+        {"farm slurm -r 24 -o " + shellWord((dir_ / "back\\slash" / "job.vdb").string()), "a backslash"},
+        {"farm slurm --sbatch qos=low" + plain, "expected one option of sbatch's, starting with -"},
+        {"farm slurm --name " + std::string(1100, 'n') + plain, "Slurm keeps at most 1024"},
+        // An Open Job Description job name holds no control character and at most 128 characters.
+        {"farm openjd --name " + shellWord("tab\there") + plain, "--name: a tab (U+0009) at character 4"},
+        {"farm openjd --name " + shellWord("esc\x1b[31m") + plain, "a control character (U+001B) at character 4"},
+        {"farm openjd --name " + shellWord("nel\xc2\x85") + plain, "a control character (U+0085) at character 4"},
+        {"farm openjd --name " + std::string(129, 'n') + plain, "has 129 characters"},
+        // A JSON template holds UTF-8 text only.
+        {"farm openjd -r 24 -o " + shellWord((dir_ / "caf\xe9.vdb").string()), "not UTF-8"},
+    };
+    for (const Case& test : cases) {
+        const auto result = run(test.arguments);
+        EXPECT_EQ(result.exitCode, 2) << test.arguments << ": " << result.err;
+        EXPECT_CONTAINS(result.err, test.message);
+        EXPECT_EQ(filesIn(dir_), std::set<std::string>{"back\\slash"}) << test.arguments;
+        EXPECT_TRUE(fs::is_empty(dir_ / "back\\slash"));
+    }
+}
+
+TEST_F(Hostile, JobFilesQuoteWhatTheirParsersWouldMisread) {
+    // Quotes, `#`, `$`, spaces, `%` and `{{ }}`: carried, each quoted for the parser that reads it
+    // (tests/farm runs the real sbatch and openjd on many more).
+    const fs::path folder = dir_ / "My Projects 100%";
+    fs::create_directories(folder);
+    const std::string name = "it's \"#1\" $HOME {{Param.Output}} \\";
+    const std::string flags = " -r 24 --name " + shellWord(name) + " -o " + shellWord((folder / "a#b.vdb").string());
+    ASSERT_EQ(run("farm slurm" + flags).exitCode, 0);
+    const std::string script = readFile(folder / "a#b.slurm");
+    EXPECT_CONTAINS(script, "\n#SBATCH --job-name=\"it's \\\"#1\\\" $HOME {{Param.Output}} \\\\\"\n");
+    EXPECT_CONTAINS(script, "\n#SBATCH --output=\"" + folder.string() + "%/a#b.slurm-%A_%a.log\"\n");
+    EXPECT_CONTAINS(script, " -o '" + (folder / "a#b.vdb").string() + "' --skip-existing\n");
+    ASSERT_EQ(run("farm openjd --force" + flags).exitCode, 0);
+    const std::string job = readFile(folder / "a#b.openjd.json");
+    EXPECT_CONTAINS(job, "\"name\": \"{{Param.JobName}}\"");
+    EXPECT_CONTAINS(job, "\"default\": \"it's \\\"#1\\\" $HOME {{Param.Output}} \\\\\"");
+}
+
+/// A keyframed constant whose |c| between frames offset+10 and offset+20 exceeds every key's
+/// (two smooth components peaking together), with a bailout just enough for the keys.
+std::string peakingAnimation(int offset) {
+    auto frame = [&](int at) { return std::to_string(offset + at); };
+    return R"({"fractal": {"c": [1, 0, 0, 0, 0, 0, 0, 0], "bailout": 10}, "animation": {
+      "fractal.c": [{"frame": )" +
+           frame(9) + R"(, "value": [1, -1, 0, 0, 0, 0, 0, 0], "interpolation": "smooth"},
+                    {"frame": )" +
+           frame(10) + R"(, "value": [1, 0, 0, 0, 0, 0, 0, 0], "interpolation": "smooth"},
+                    {"frame": )" +
+           frame(20) + R"(, "value": [0, 1, 0, 0, 0, 0, 0, 0], "interpolation": "smooth"},
+                    {"frame": )" +
+           frame(21) + R"(, "value": [-1, 1, 0, 0, 0, 0, 0, 0]}],
+      "fractal.bailout": [{"frame": )" +
+           frame(9) + R"(, "value": 10}, {"frame": )" + frame(10) + R"(, "value": 1.62},
+                          {"frame": )" +
+           frame(20) + R"(, "value": 1.62}, {"frame": )" + frame(21) + R"(, "value": 10}]}})";
+}
+
+TEST_F(Hostile, EveryFrameOfAMillionIsCheckedBeforeAnythingIsWritten) {
+    // Frame 900011 fails, between keys that pass: found in the whole range 0-999999 (about a
+    // microsecond a frame; it was 160 s of validating frame by frame), nothing written.
+    write("late.json", peakingAnimation(900000));
+    const std::string output = " -o " + path("late.vdb");
+    for (const std::string command : {"farm slurm", "farm openjd"}) {
+        const auto result = run(command + " -p " + path("late.json") + " --frames 0-999999 --chunk 1000" + output);
+        EXPECT_EQ(result.exitCode, 2) << command << ": " << result.err;
+        EXPECT_CONTAINS(result.err, "at frame 900011: fractal.bailout: is 1.62 but must be at least");
+    }
+    // bake and mesh check every frame before the first bake too.
+    write("early.json", peakingAnimation(0));
+    for (const std::string command : {"bake -r 16", "mesh -r 16"}) {
+        const auto result = run(command + " -q -p " + path("early.json") + " --frames 1-30 -o " +
+                                path(command.starts_with("bake") ? "early.vdb" : "early.ply"));
+        EXPECT_EQ(result.exitCode, 2) << command << ": " << result.err;
+        EXPECT_CONTAINS(result.err, "at frame 11: fractal.bailout");
+    }
+    EXPECT_EQ(filesIn(dir_), (std::set<std::string>{"early.json", "late.json"}));
+    // Keys at both ends of the range: every one of the million frames is compared, and passes.
+    write("whole.json", R"({"animation": {"fractal.c": [
+        {"frame": 0, "value": [-0.4, 0.6, 0, 0, 0, 0, 0, 0], "interpolation": "smooth"},
+        {"frame": 500000, "value": [0.6, -0.4, 0.2, 0, 0, 0.3, 0, 0], "interpolation": "smooth"},
+        {"frame": 999999, "value": [-0.4, -0.6, 0, 0, 0, 0, 0, 0]}]}})");
+    const auto written = run("farm slurm -p " + path("whole.json") + " --frames 0-999999 --chunk 1000" + output);
+    ASSERT_EQ(written.exitCode, 0) << written.err;
+    EXPECT_CONTAINS(readFile(dir_ / "late.slurm"), "\n#SBATCH --array=0-999\n");
+}
+
 TEST_F(Hostile, ThePovrayIncludeStopsOnInvalidSettings) {
     if (std::system("command -v povray > /dev/null 2>&1") != 0) GTEST_SKIP() << "povray is not installed";
     ASSERT_EQ(run("povray -q -o " + path("scene.pov")).exitCode, 0);  // writes dqjulia.inc beside it

@@ -30,9 +30,22 @@ struct Track {
 };
 
 /// The parameters at `frame`: every animated value replaced by its track's value there (before
-/// the first key the first value holds, after the last the last); iterations round to the
-/// nearest whole number. Not validated: call validate() on the result. Without tracks, a copy.
+/// the first key the first value holds, after the last the last; between two keys a value lies
+/// between theirs); iterations round to the nearest whole number. Not validated: call validate()
+/// on the result, or use validAtFrame. Without tracks, a copy.
 DQJ_API Params atFrame(const Params& params, double frame);
+/// atFrame without the animation: the still parameters of one frame. Not validated.
+DQJ_API Params stillAtFrame(const Params& params, double frame);
+/// atFrame, validated: a ParamError names the frame ("at frame 12: fractal.bailout: ...").
+/// Without tracks, `params` as it is (not validated again).
+DQJ_API Params validAtFrame(const Params& params, double frame);
+/// Checks that validAtFrame(params, f) passes for every whole frame f from `first` to `last`, given
+/// that validate(params) has passed; throws the ParamError validAtFrame would for the first
+/// frame that fails. Cost: the keys were checked by validate; here, for the frames within the
+/// keys' span, about 0.2 microseconds a frame where the constant is animated and 0.06 a frame for
+/// each rotation of the slice where a rotation is (a million frames: 0.2 s, 2 s with 28 animated
+/// rotations); nothing for the frames outside the span or without keys.
+DQJ_API void checkFrames(const Params& params, int first, int last);
 /// "fractal.c", "fractal.iterations", "fractal.bailout" or "slice.rotations[i].degrees".
 DQJ_API std::string trackKey(const Track& track);
 }  // namespace dqj
