@@ -8,6 +8,7 @@
 #include "explore.hpp"
 #include "dqjulia/render.hpp"
 #include "file_names.hpp"
+#include "message_text.hpp"
 
 namespace dqj::cli {
 namespace {
@@ -37,7 +38,7 @@ int runExplore(const ExploreCommandOptions& options) {
     const fs::path sheetPath = folder / "sheet.png";
     std::error_code error;
     fs::create_directories(folder, error);
-    if (error) throw std::runtime_error("cannot create folder '" + options.folder + "': " + error.message());
+    if (error) throw std::runtime_error("cannot create folder '" + inputExcerpt(options.folder) + "': " + error.message());
     checkOutputPath(utf8FromPath(sheetPath), options.force, "--output");
 
     ExploreOptions exploreOptions;

@@ -1,4 +1,5 @@
 // dqjulia: render, evaluate and inspect dual-quaternion Julia fractals from the command line.
+#include <cstdio>
 #include <iostream>
 #include <map>
 #include <string>
@@ -11,6 +12,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "dqjulia/dqjulia.h"
+#include "message_text.hpp"
 
 namespace {
 
@@ -48,6 +50,25 @@ int run(int argc, char** argv) {
     return kBadInput;
 }
 
+/// run(), with what escapes it (the argument parser running out of memory, say) reported as a
+/// failure: an exception leaving main would end the process in std::terminate (exit 134).
+int runReported(int argc, char** argv) {
+    try {
+        return run(argc, argv);
+    } catch (const std::bad_alloc&) {
+        std::fputs("dqjulia: out of memory: this process may not use enough memory to start the work (see ulimit -v "
+                   "and the container's memory limit)\n",
+                   stderr);
+    } catch (const std::exception& error) {
+        try {
+            std::fprintf(stderr, "dqjulia: %s\n", dqj::printableText(error.what()).c_str());
+        } catch (const std::bad_alloc&) {
+            std::fputs("dqjulia: out of memory\n", stderr);
+        }
+    }
+    return dqj::cli::kFailure;
+}
+
 }  // namespace
 
 #ifdef _WIN32
@@ -67,8 +88,8 @@ int wmain(int argc, wchar_t** wideArgv) {
     for (std::string& argument : arguments) argv.push_back(argument.data());
     argv.push_back(nullptr);
     ::SetConsoleOutputCP(CP_UTF8);
-    return run(argc, argv.data());
+    return runReported(argc, argv.data());
 }
 #else
-int main(int argc, char** argv) { return run(argc, argv); }
+int main(int argc, char** argv) { return runReported(argc, argv); }
 #endif

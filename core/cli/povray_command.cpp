@@ -9,6 +9,8 @@
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/povray.hpp"
 #include "file_names.hpp"
+#include "message_text.hpp"
+#include "text_input.hpp"
 
 namespace dqj::cli {
 namespace {
@@ -66,14 +68,14 @@ int runPovray(const PovrayOptions& options) {
     if (!files.df3.empty()) checkOutputPath(files.df3, options.force, "--df3");
     if (!files.df3Scene.empty()) checkOutputPath(files.df3Scene, options.force, "--df3");
     if (!files.include.empty()) {
-        std::ifstream existing(pathFromUtf8(files.include), std::ios::binary);
-        std::ostringstream text;
-        text << existing.rdbuf();
-        if (existing && text.str() != povrayInclude() && !options.force)
-            throw ParamError("output.path", "'" + files.include +
+        std::error_code error;
+        const bool regular = std::filesystem::is_regular_file(pathFromUtf8(files.include), error);
+        const bool same = regular && fileHolds(files.include, povrayInclude()) == true;
+        if (regular && !same && !options.force)
+            throw ParamError("output.path", "'" + inputExcerpt(files.include) +
                                                 "' exists and differs from this version's dqjulia.inc; pass --force to "
                                                 "replace it, or --no-include to keep it");
-        if (!existing) checkOutputPath(files.include, options.force);
+        if (!same) checkOutputPath(files.include, options.force);
     }
     if (files.scene.empty())
         std::cerr << "dqjulia povray: N = " << params.fractal.iterations

@@ -13,7 +13,7 @@
 #include <cstring>
 #include <ctime>
 #include <filesystem>
-#include <fstream>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <streambuf>
@@ -33,6 +33,7 @@
 #endif
 
 #include "file_names.hpp"
+#include "text_input.hpp"
 
 namespace dqj {
 namespace {
@@ -73,12 +74,8 @@ int processId() { return int(::getpid()); }
 /// The process umask, read without changing it: umask() can only be read by setting it,
 /// which would race with other threads creating files. Linux reports it in /proc.
 mode_t currentUmask() {
-    std::ifstream status("/proc/self/status");
-    std::string line;
-    while (std::getline(status, line)) {
-        if (line.rfind("Umask:", 0) == 0) return static_cast<mode_t>(std::stoul(line.substr(6), nullptr, 8));
-    }
-    return 022;
+    const std::optional<std::string> umask = lineStartingWith("/proc/self/status", "Umask:");
+    return umask ? static_cast<mode_t>(std::strtoul(umask->c_str(), nullptr, 8)) : 022;
 }
 #endif
 
@@ -268,24 +265,8 @@ struct AtomicFile::State {
     std::unique_ptr<std::ostream> stream;
 };
 
-std::string printableText(const std::string& text) {
-    std::string result;
-    result.reserve(text.size());
-    for (const char ch : text) {
-        const auto byte = static_cast<unsigned char>(ch);
-        if ((byte < 0x20 && ch != '\n' && ch != '\t') || byte == 0x7f) {
-            char escaped[8];
-            std::snprintf(escaped, sizeof escaped, "\\x%02x", byte);
-            result += escaped;
-        } else {
-            result += ch;
-        }
-    }
-    return result;
-}
-
 std::string AtomicFile::failureMessage(const std::string& path, const std::string& reason) {
-    return printableText("cannot write '" + path + "': " + reason);
+    return printableText("cannot write '" + inputExcerpt(path) + "': " + reason);
 }
 
 AtomicFile::AtomicFile(std::string path, Existing existing)

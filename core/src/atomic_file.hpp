@@ -18,12 +18,9 @@
 #include <string>
 
 #include "dqjulia/params.hpp"  // Existing
+#include "message_text.hpp"      // printableText, inputExcerpt
 
 namespace dqj {
-
-/// `text` with NUL and the other control characters except newline and tab written as \xNN,
-/// so a message printed through a C string is never cut short and cannot drive a terminal.
-std::string printableText(const std::string& text);
 
 class AtomicFile {
 public:
