@@ -16,6 +16,36 @@
 
 namespace {
 
+/// The argument parser's message `message` as dqjulia shows it: printable (newlines kept), and each argument
+/// longer than an excerpt that it quotes (whole, or its value after "--flag=") shown as
+/// inputExcerpt() shows it, with its length; the parser quotes what it was given whole.
+std::string parserMessage(const std::string& message, int argc, char** argv) {
+    std::vector<std::string> quoted;
+    for (int index = 1; index < argc; ++index) {
+        const std::string argument = argv[index];
+        const std::size_t equals = argument.find('=');
+        for (const std::string& part : {argument, equals == std::string::npos ? std::string() : argument.substr(equals + 1)})
+            if (dqj::inputExcerpt(part) != dqj::printableText(part)) quoted.push_back(part);
+    }
+    std::string shown;
+    for (std::size_t at = 0; at < message.size();) {
+        std::size_t next = message.size();
+        const std::string* found = nullptr;
+        for (const std::string& part : quoted) {  // the earliest, and of those the longest
+            const std::size_t position = message.find(part, at);
+            if (position < next || (position == next && found && part.size() > found->size())) {
+                next = position;
+                found = &part;
+            }
+        }
+        shown += dqj::printableText(std::string_view(message).substr(at, next - at));
+        if (!found) break;
+        shown += dqj::inputExcerpt(*found);
+        at = next + found->size();
+    }
+    return shown;
+}
+
 int run(int argc, char** argv) {
     using namespace dqj::cli;
     CLI::App app{
@@ -41,7 +71,8 @@ int run(int argc, char** argv) {
     } catch (const CLI::CallForVersion& version) {
         return app.exit(version);
     } catch (const CLI::ParseError& error) {
-        app.exit(error);  // prints the message and a hint to use --help
+        // CLI11's message and hint to use --help, as app.exit(error) prints them, bounded.
+        std::cerr << parserMessage(CLI::FailureMessage::simple(&app, error), argc, argv);
         return kBadInput;
     }
     installInterruptHandlers();

@@ -79,7 +79,9 @@ public:
     ~BusyScope() {
         if (!context_) return;
         std::lock_guard lock(registryMutex);
-        registry().at(handleValue(handle_)).busy = false;
+        // find(), not at(): nothing may throw from a destructor (dqj_context_destroy refuses a busy context).
+        const auto it = registry().find(handleValue(handle_));
+        if (it != registry().end()) it->second.busy = false;
     }
     BusyScope(const BusyScope&) = delete;
     BusyScope& operator=(const BusyScope&) = delete;

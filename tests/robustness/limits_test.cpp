@@ -493,7 +493,11 @@ TEST_F(Limited, AMessageQuotesALongInputAsAnExcerptAndItsLength) {
           "bake -q --max-memory " + longText + " -o OUT/a.vdb", "bake -q --tiles " + longText + " -o OUT/a.vdb",
           "render -q --rotate " + longText + " -o OUT/a.png", "render -q --slice " + longText + " -o OUT/a.png",
           "render -q -W 8 -H 8 -o OUT/" + longText + "/a.png", "bake -q -o OUT/" + longText + ".png",
-          "merge -q OUT/" + longText + ".vdb -o OUT/a.vdb"}) {
+          "merge -q OUT/" + longText + ".vdb -o OUT/a.vdb",
+          // The argument parser's own messages (CLI11 quotes what it was given whole).
+          "bake -q -r " + longText + " -o OUT/a.vdb", "bake -q --threads 1" + longText + " -o OUT/a.vdb",
+          "bake -q " + longText + " -o OUT/a.vdb", "bake -q --bogus=" + longText + " -o OUT/a.vdb",
+          "render -q -p IN/" + longText + ".json -o OUT/a.png"}) {
         SCOPED_TRACE(line.substr(0, 30));
         outcome = run(line);
         expectBoundedMessage(outcome, "100,0");  // the path's length is 100,0xx with the folder
