@@ -124,10 +124,14 @@ fetch lz4 'lz4_1.9.4.orig.tar.*'
 fetch c-blosc 'c-blosc_1.21.3*.orig.tar.*'
 fetch openvdb 'openvdb_10.0.1.orig.tar.*'
 # oneTBB: a thread the system refuses (ulimit -u, ulimit -v) means fewer threads, not std::terminate.
-patch -d "$work/src/onetbb" -p1 --quiet < "$here/patches/onetbb-2021.8.0-thread-launch-failures.patch" \
-  || { echo "dqjulia deps: patching oneTBB failed" >&2; exit 1; }
-# OpenVDB's readers made safe for damaged files (each patch says what and why).
-for fix in compression-bounds read-bools node-origins read-failures; do
+# oneTBB: a task's exception kept (as bad_alloc) when memory for keeping it is exhausted.
+for fix in thread-launch-failures exception-out-of-memory; do
+  patch -d "$work/src/onetbb" -p1 --quiet < "$here/patches/onetbb-2021.8.0-$fix.patch" \
+    || { echo "dqjulia deps: patching oneTBB ($fix) failed" >&2; exit 1; }
+done
+# OpenVDB's readers made safe for damaged files, and its accessor registry for exhausted memory
+# (each patch says what and why).
+for fix in compression-bounds read-bools node-origins read-failures accessor-registration; do
   patch -d "$work/src/openvdb" -p1 --quiet < "$here/patches/openvdb-10.0.1-$fix.patch" \
     || { echo "dqjulia deps: patching OpenVDB ($fix) failed" >&2; exit 1; }
 done

@@ -62,23 +62,32 @@ inline void parallelForWithProgress(std::size_t count, const ProgressCallback& p
     std::exception_ptr error;
 
     // Items never throw into TBB: the first failure is kept and the rest are skipped. `afterItem`
-    // runs on the thread that ran the item, after it.
+    // runs on the thread that ran the item, after it. TBB itself may still throw (memory for its
+    // own tasks refused): kept as an item's failure is, since on the worker thread an exception
+    // leaving would terminate the process.
+    auto keep = [&] {
+        std::lock_guard<std::mutex> lock(errorMutex);
+        if (!error) error = std::current_exception();
+        stop = true;
+    };
     auto runItems = [&](const std::function<void()>& afterItem) {
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1),
-                          [&](const tbb::blocked_range<std::size_t>& range) {
-                              for (std::size_t index = range.begin(); index != range.end(); ++index) {
-                                  if (stop.load(std::memory_order_relaxed)) return;
-                                  try {
-                                      work(index, stop);
-                                      done.fetch_add(1, std::memory_order_relaxed);
-                                      if (afterItem) afterItem();
-                                  } catch (...) {
-                                      std::lock_guard<std::mutex> lock(errorMutex);
-                                      if (!error) error = std::current_exception();
-                                      stop = true;
+        try {
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1),
+                              [&](const tbb::blocked_range<std::size_t>& range) {
+                                  for (std::size_t index = range.begin(); index != range.end(); ++index) {
+                                      if (stop.load(std::memory_order_relaxed)) return;
+                                      try {
+                                          work(index, stop);
+                                          done.fetch_add(1, std::memory_order_relaxed);
+                                          if (afterItem) afterItem();
+                                      } catch (...) {
+                                          keep();
+                                      }
                                   }
-                              }
-                          });
+                              });
+        } catch (...) {
+            keep();
+        }
     };
 
     if (!progress) {
