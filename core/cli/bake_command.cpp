@@ -59,7 +59,8 @@ int runBake(const BakeFlags& flags) {
     const Params params = flags.load();
     std::string extension = flags.output.size() >= 4 ? flags.output.substr(flags.output.size() - 4) : "";
     for (char& ch : extension) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-    if (extension != ".vdb") throw ParamError("output.path", "--output '" + inputExcerpt(flags.output) + "' must end in .vdb");
+    if (extension != ".vdb")
+        throw ParamError("output.path", "--output '" + inputExcerpt(flags.output) + "' must end in .vdb");
     const std::uint64_t memoryLimit = flags.memoryLimit();
     flags.checkExistingFlags();
     const std::vector<Job> jobs = plan(flags, params);

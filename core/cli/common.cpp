@@ -175,11 +175,12 @@ void checkOutputPath(const std::string& path, bool force, const std::string& fla
         throw ParamError("output.path", flag + " '" + shown + "' exists; pass --force to overwrite it");
     const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
     if (!fs::is_directory(folder, error))
-        throw ParamError("output.path",
-                         flag + " '" + shown + "': the folder '" + inputExcerpt(utf8FromPath(folder)) + "' does not exist");
+        throw ParamError("output.path", flag + " '" + shown + "': the folder '" + inputExcerpt(utf8FromPath(folder)) +
+                                            "' does not exist");
 #ifndef _WIN32  // Windows: access() does not read a folder's permissions (ACLs); the probe below tries
     if (::access(folder.c_str(), W_OK) != 0)
-        throw ParamError("output.path", flag + " '" + shown + "': the folder '" + inputExcerpt(folder.string()) + "' is not writable");
+        throw ParamError("output.path",
+                         flag + " '" + shown + "': the folder '" + inputExcerpt(folder.string()) + "' is not writable");
 #endif
     try {
         checkWritable(path);  // not a device or FIFO, and a file can really be created there

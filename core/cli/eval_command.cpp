@@ -55,9 +55,9 @@ int runEval(const EvalOptions& options) {
         const std::string where = "standard input, line " + std::to_string(input.lineNumber());
         if (result == LineReader::Result::TooLong) {
             std::fflush(stdout);
-            throw ParamError("", where + ": longer than " + std::to_string(kMaxLineBytes) + " bytes, the most a line of " +
-                                     std::to_string(expected) + " numbers may have; it starts \"" +
-                                     inputExcerpt(line, false) + "\"");
+            throw ParamError("", where + ": longer than " + std::to_string(kMaxLineBytes) +
+                                     " bytes, the most a line of " + std::to_string(expected) +
+                                     " numbers may have; it starts \"" + inputExcerpt(line, false) + "\"");
         }
         const std::size_t start = line.find_first_not_of(" \t");
         if (start == std::string::npos || line[start] == '#') continue;

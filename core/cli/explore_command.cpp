@@ -38,7 +38,8 @@ int runExplore(const ExploreCommandOptions& options) {
     const fs::path sheetPath = folder / "sheet.png";
     std::error_code error;
     fs::create_directories(folder, error);
-    if (error) throw std::runtime_error("cannot create folder '" + inputExcerpt(options.folder) + "': " + error.message());
+    if (error)
+        throw std::runtime_error("cannot create folder '" + inputExcerpt(options.folder) + "': " + error.message());
     checkOutputPath(utf8FromPath(sheetPath), options.force, "--output");
 
     ExploreOptions exploreOptions;

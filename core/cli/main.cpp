@@ -24,7 +24,8 @@ std::string parserMessage(const std::string& message, int argc, char** argv) {
     for (int index = 1; index < argc; ++index) {
         const std::string argument = argv[index];
         const std::size_t equals = argument.find('=');
-        for (const std::string& part : {argument, equals == std::string::npos ? std::string() : argument.substr(equals + 1)})
+        for (const std::string& part :
+             {argument, equals == std::string::npos ? std::string() : argument.substr(equals + 1)})
             if (dqj::inputExcerpt(part) != dqj::printableText(part)) quoted.push_back(part);
     }
     std::string shown;
@@ -87,9 +88,10 @@ int runReported(int argc, char** argv) {
     try {
         return run(argc, argv);
     } catch (const std::bad_alloc&) {
-        std::fputs("dqjulia: out of memory: this process may not use enough memory to start the work (see ulimit -v "
-                   "and the container's memory limit)\n",
-                   stderr);
+        std::fputs(
+            "dqjulia: out of memory: this process may not use enough memory to start the work (see ulimit -v "
+            "and the container's memory limit)\n",
+            stderr);
     } catch (const std::exception& error) {
         try {
             std::fprintf(stderr, "dqjulia: %s\n", dqj::printableText(error.what()).c_str());

@@ -25,7 +25,8 @@ constexpr int kTileRows = 8;
 openvdb::FloatGrid::ConstPtr readDensity(const std::string& path) {
     auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(findGrid(readVdbFile(path), "density"));
     if (!grid)
-        throw std::runtime_error("'" + inputExcerpt(path) + "' has no float grid named \"density\" (bake it with dqjulia bake)");
+        throw std::runtime_error("'" + inputExcerpt(path) +
+                                 "' has no float grid named \"density\" (bake it with dqjulia bake)");
     return grid;
 }
 

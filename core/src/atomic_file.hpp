@@ -18,7 +18,7 @@
 #include <string>
 
 #include "dqjulia/params.hpp"  // Existing
-#include "message_text.hpp"      // printableText, inputExcerpt
+#include "message_text.hpp"    // printableText, inputExcerpt
 
 namespace dqj {
 

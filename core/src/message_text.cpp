@@ -12,7 +12,10 @@ namespace {
 /// continuation byte, a sequence cut short or overlong: shown byte by byte).
 std::size_t sequenceLength(std::string_view text, std::size_t at) {
     const auto lead = static_cast<unsigned char>(text[at]);
-    const std::size_t length = lead >= 0xF0 && lead <= 0xF4 ? 4 : lead >= 0xE0 ? 3 : lead >= 0xC2 && lead < 0xE0 ? 2 : 1;
+    const std::size_t length = lead >= 0xF0 && lead <= 0xF4  ? 4
+                               : lead >= 0xE0                ? 3
+                               : lead >= 0xC2 && lead < 0xE0 ? 2
+                                                             : 1;
     if (length == 1 || lead > 0xF4 || at + length > text.size()) return 1;
     for (std::size_t next = at + 1; next < at + length; ++next)
         if ((static_cast<unsigned char>(text[next]) & 0xC0) != 0x80) return 1;

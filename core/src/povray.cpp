@@ -455,7 +455,8 @@ PovrayFiles povrayFiles(const Params& params, const std::string& scenePath, cons
         const std::string df3Name = utf8FromPath(pathFromUtf8(files.df3).filename());
         for (const char ch : df3Name)
             if (ch < 0x20 || ch > 0x7e || ch == '"' || ch == '\\')
-                throw ParamError("output.path", "'" + inputExcerpt(scenePath) + "': with --df3 the scene names the grid file '" +
+                throw ParamError("output.path", "'" + inputExcerpt(scenePath) +
+                                                    "': with --df3 the scene names the grid file '" +
                                                     inputExcerpt(df3Name) +
                                                     "' in a POV-Ray string, which carries only printable ASCII "
                                                     "characters without \" and \\; rename the scene");

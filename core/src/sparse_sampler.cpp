@@ -225,8 +225,8 @@ private:
     std::array<std::uint64_t, 3> blocksAlong(int step) const {
         std::array<std::uint64_t, 3> counts{};
         for (int axis = 0; axis < 3; ++axis)
-            counts[axis] = std::uint64_t((std::int64_t(indexBox_.max()[axis]) -
-                                          floorTo(indexBox_.min()[axis], step)) / step + 1);
+            counts[axis] =
+                std::uint64_t((std::int64_t(indexBox_.max()[axis]) - floorTo(indexBox_.min()[axis], step)) / step + 1);
         return counts;
     }
 
@@ -389,12 +389,14 @@ private:
         const std::string blocks = std::to_string(leaves) + " blocks of 8^3 voxels to sample";
         throw MemoryLimitError(
             "resolution " + std::to_string(params_.bake.resolution) +
-                (final        ? " needs an estimated " + formatBytes(estimate) + " (" + blocks +
-                                    "), more than the limit of " + limit
-                 : leaves > 0 ? " needs more than the limit of " + limit + ": the first " + blocks +
-                                    " already need " + formatBytes(estimate)
-                              : " needs at least " + formatBytes(estimate) + " before any voxel is sampled, more than "
-                                                                             "the limit of " + limit) +
+                (final ? " needs an estimated " + formatBytes(estimate) + " (" + blocks + "), more than the limit of " +
+                             limit
+                 : leaves > 0 ? " needs more than the limit of " + limit + ": the first " + blocks + " already need " +
+                                    formatBytes(estimate)
+                              : " needs at least " + formatBytes(estimate) +
+                                    " before any voxel is sampled, more than "
+                                    "the limit of " +
+                                    limit) +
                 (processLimited_
                      ? std::string(
                            "; lower the resolution, bake a smaller region (bake.bounds) or raise the process's limit")

@@ -57,7 +57,8 @@ std::optional<std::string> readUpTo(const std::string& path, std::size_t limit) 
     std::error_code error;
     const auto status = std::filesystem::status(pathFromUtf8(path), error);
     if (std::filesystem::exists(status) && !std::filesystem::is_regular_file(status))
-        throw std::runtime_error(printableText("cannot read " + source + ": not a regular file"));  // a FIFO would block
+        throw std::runtime_error(
+            printableText("cannot read " + source + ": not a regular file"));  // a FIFO would block
     const Descriptor file{openForReading(path)};
     if (file.fd < 0 && errno == ENOENT) return std::nullopt;
     if (file.fd < 0) throwReadError(source, errno);

@@ -94,7 +94,8 @@ TileHeader readTileHeader(const std::string& path) {
         header.hash = metadata->metaValue<std::string>(kHashKey);
         header.version = metadata->metaValue<std::string>(kVersionKey);
         header.voxelSize = metadata->metaValue<double>("dqjulia_voxel_size");
-        header.gridBytes = std::uint64_t(std::max<openvdb::Int64>(0, metadata->metaValue<openvdb::Int64>(kGridBytesKey)));
+        header.gridBytes =
+            std::uint64_t(std::max<openvdb::Int64>(0, metadata->metaValue<openvdb::Int64>(kGridBytesKey)));
     } catch (const ParamError&) {
         throw fail("is a damaged tile: its tiling metadata cannot be read");
     } catch (const openvdb::Exception&) {
@@ -125,15 +126,16 @@ void checkTilesBelongTogether(const std::vector<TileHeader>& headers) {
         else if (header.full != first.full || header.voxelSize != first.voxelSize)
             differs = "its grid differs";
         if (!differs.empty())
-            throw ParamError("tiles", "'" + inputExcerpt(header.path) + "' is not a tile of the same bake as '" + inputExcerpt(first.path) +
-                                          "': " + differs);
+            throw ParamError("tiles", "'" + inputExcerpt(header.path) + "' is not a tile of the same bake as '" +
+                                          inputExcerpt(first.path) + "': " + differs);
     }
     std::map<int, const TileHeader*> byIndex;
     for (const TileHeader& header : headers) {
         const auto [at, added] = byIndex.emplace(header.tile.index, &header);
         if (!added)
-            throw ParamError("tiles", "'" + inputExcerpt(at->second->path) + "' and '" + inputExcerpt(header.path) + "' are both tile " +
-                                          std::to_string(header.tile.index) + " of " + tilingText(first.tile));
+            throw ParamError("tiles", "'" + inputExcerpt(at->second->path) + "' and '" + inputExcerpt(header.path) +
+                                          "' are both tile " + std::to_string(header.tile.index) + " of " +
+                                          tilingText(first.tile));
     }
     const int count = tileCount(first.tile);
     std::string missing;
@@ -305,7 +307,8 @@ MergeStats mergeTiles(const std::vector<std::string>& tiles, const std::string& 
               [](const TileHeader& a, const TileHeader& b) { return a.tile.index < b.tile.index; });
     const Params params = parseParams(headers.front().document, "'" + inputExcerpt(headers.front().path) + "'");
     if (bakeIndexBox(params) != headers.front().full)
-        throw ParamError("tiles", "'" + inputExcerpt(headers.front().path) + "' is a damaged tile: its box is not its bake's");
+        throw ParamError("tiles",
+                         "'" + inputExcerpt(headers.front().path) + "' is a damaged tile: its box is not its bake's");
     checkMergeMemory(headers, params, memoryLimit);
     AtomicFile file(path, existing);  // fails now, before the work, if the folder is not writable
 
@@ -321,12 +324,14 @@ MergeStats mergeTiles(const std::vector<std::string>& tiles, const std::string& 
         stats.tileBytes += std::filesystem::file_size(pathFromUtf8(header.path));
         auto tileSurface = openvdb::gridPtrCast<openvdb::FloatGrid>(findGrid(contents, "surface"));
         if (!tileSurface || tileSurface->getGridClass() != openvdb::GRID_LEVEL_SET)
-            throw ParamError("tiles", "'" + inputExcerpt(header.path) + "' is a damaged tile: it has no level set \"surface\"");
+            throw ParamError("tiles",
+                             "'" + inputExcerpt(header.path) + "' is a damaged tile: it has no level set \"surface\"");
         if (!surface) {
             surface = tileSurface;
         } else {
             if (tileSurface->transform() != surface->transform() || tileSurface->background() != surface->background())
-                throw ParamError("tiles", "'" + inputExcerpt(header.path) + "' is a damaged tile: its grid differs from '" +
+                throw ParamError("tiles", "'" + inputExcerpt(header.path) +
+                                              "' is a damaged tile: its grid differs from '" +
                                               inputExcerpt(headers.front().path) + "''s");
             openvdb::tools::csgUnion(surface->tree(), tileSurface->tree(), /*prune=*/false);
         }
@@ -337,7 +342,8 @@ MergeStats mergeTiles(const std::vector<std::string>& tiles, const std::string& 
             const bool vector = grid == BakeGrid::Color;
             if (!part || (vector ? !openvdb::gridPtrCast<openvdb::Vec3SGrid>(part)
                                  : !openvdb::gridPtrCast<openvdb::FloatGrid>(part)))
-                throw ParamError("tiles", "'" + inputExcerpt(header.path) + "' is a damaged tile: it has no grid \"" + name + "\"");
+                throw ParamError("tiles", "'" + inputExcerpt(header.path) + "' is a damaged tile: it has no grid \"" +
+                                              name + "\"");
             auto& into = merged[grid];
             if (!into)
                 into = part;

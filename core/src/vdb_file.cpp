@@ -109,7 +109,9 @@ namespace {
 /// `metadataOnly`.
 VdbContents readChecked(const std::string& path, bool metadataOnly) {
     openvdb::initialize();
-    auto fail = [&](const std::string& reason) { return std::runtime_error("cannot read '" + inputExcerpt(path) + "': " + reason); };
+    auto fail = [&](const std::string& reason) {
+        return std::runtime_error("cannot read '" + inputExcerpt(path) + "': " + reason);
+    };
     const std::filesystem::path name = pathFromUtf8(path);  // UTF-8, on Windows too (file_names.hpp)
     std::ifstream in(name, std::ios::binary);
     if (!in) throw fail(std::strerror(errno));

@@ -94,10 +94,10 @@ ssize_t read(int fd, void* data, size_t size) {
 
 int pthread_create(pthread_t* thread, const pthread_attr_t* attributes, void* (*routine)(void*), void* argument) {
     static int (*real_create)(pthread_t*, const pthread_attr_t*, void* (*)(void*), void*);
-    static long long made;  /* read and written under no lock: the tests' counts are small */
+    static long long made; /* read and written under no lock: the tests' counts are small */
     if (!real_create)
-        real_create = (int (*)(pthread_t*, const pthread_attr_t*, void* (*)(void*), void*))dlsym(RTLD_NEXT,
-                                                                                             "pthread_create");
+        real_create =
+            (int (*)(pthread_t*, const pthread_attr_t*, void* (*)(void*), void*))dlsym(RTLD_NEXT, "pthread_create");
     if (mode_is("threads") && __atomic_fetch_add(&made, 1, __ATOMIC_SEQ_CST) >= allowed_count()) {
         const char* log = getenv("DQJ_FAULT_LOG");
         if (log && *log) {

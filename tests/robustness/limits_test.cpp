@@ -85,13 +85,12 @@ Outcome runLimited(const std::string& program, const std::vector<std::string>& a
         const int e = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0666);
         if (in < 0 || o < 0 || e < 0 || ::dup2(in, 0) < 0 || ::dup2(o, 1) < 0 || ::dup2(e, 2) < 0) ::_exit(125);
         if (limits.addressSpace) {
-            const struct rlimit cap {*limits.addressSpace, *limits.addressSpace};
+            const struct rlimit cap { *limits.addressSpace, *limits.addressSpace };
             if (::setrlimit(RLIMIT_AS, &cap) != 0) ::_exit(125);
         }
-        if (asOtherUser && (::setgroups(0, nullptr) != 0 || ::setgid(user) != 0 || ::setuid(user) != 0))
-            ::_exit(124);
+        if (asOtherUser && (::setgroups(0, nullptr) != 0 || ::setgid(user) != 0 || ::setuid(user) != 0)) ::_exit(124);
         if (limits.processes) {
-            const struct rlimit cap {*limits.processes, *limits.processes};
+            const struct rlimit cap { *limits.processes, *limits.processes };
             if (::setrlimit(RLIMIT_NPROC, &cap) != 0) ::_exit(125);
         }
         ::execve(program.c_str(), argv.data(), envp.data());
@@ -299,10 +298,10 @@ int keepGoing(double, void*) { return 1; }
 /// In a child process (a death test: the limits must not bind this one): a bake through the C
 /// ABI, its progress callback included, with no thread to spare. Exits with its status.
 [[noreturn]] void bakeThroughTheCApiWithoutThreads(const std::string& path) {
-    if (::geteuid() == 0 && (::setgroups(0, nullptr) != 0 || ::setgid(freshUserId()) != 0 ||
-                             ::setuid(freshUserId()) != 0))
+    if (::geteuid() == 0 &&
+        (::setgroups(0, nullptr) != 0 || ::setgid(freshUserId()) != 0 || ::setuid(freshUserId()) != 0))
         std::_Exit(100);
-    const struct rlimit none {1, 1};
+    const struct rlimit none { 1, 1 };
     if (::setrlimit(RLIMIT_NPROC, &none) != 0) std::_Exit(101);
     dqj_context context = nullptr;
     if (dqj_context_create(&context) != DQJ_OK) std::_Exit(102);
@@ -365,10 +364,10 @@ TEST_F(Limited, TheMemoryGuardRefusesUpFrontUnderACapAtTheLargestResolution) {
 }
 
 TEST_F(Limited, TheMemoryGuardRefusesUpFrontAtAnyResolutionForAnyLimit) {
-    for (const char* line : {"bake -q -r 16384 --max-memory 200M -o OUT/big.vdb",
-                             "bake -q -r 16384 --max-memory 200M --dense -o OUT/big.vdb",
-                             "mesh -q -r 16384 --max-memory 50M -o OUT/big.ply",
-                             "bake -q -r 8192 --max-memory 64M -o OUT/big.vdb"}) {
+    for (const char* line :
+         {"bake -q -r 16384 --max-memory 200M -o OUT/big.vdb",
+          "bake -q -r 16384 --max-memory 200M --dense -o OUT/big.vdb",
+          "mesh -q -r 16384 --max-memory 50M -o OUT/big.ply", "bake -q -r 8192 --max-memory 64M -o OUT/big.vdb"}) {
         SCOPED_TRACE(line);
         const Outcome outcome = run(line);
         EXPECT_EQ(outcome.exitCode, 2) << outcome.err;
