@@ -11,6 +11,7 @@
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/threads.hpp"
 #include "dqjulia/tiles.hpp"
+#include "message_text.hpp"
 
 namespace dqj::cli {
 namespace {
@@ -62,7 +63,8 @@ int runBake(const BakeFlags& flags) {
     const Params params = flags.load();
     std::string extension = flags.output.size() >= 4 ? flags.output.substr(flags.output.size() - 4) : "";
     for (char& ch : extension) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-    if (extension != ".vdb") throw ParamError("output.path", "--output '" + flags.output + "' must end in .vdb");
+    if (extension != ".vdb")
+        throw ParamError("output.path", "--output '" + inputExcerpt(flags.output) + "' must end in .vdb");
     const std::uint64_t memoryLimit = flags.memoryLimit();
     flags.checkExistingFlags();
     const std::vector<Job> jobs = plan(flags, params);

@@ -10,6 +10,7 @@
 
 #include "dqjulia/threads.hpp"
 #include "file_names.hpp"
+#include "message_text.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -47,7 +48,7 @@ int parseFrame(const std::string& text, const std::string& whole) {
         used = 0;
     }
     if (text.empty() || used != text.size() || value < 0 || value > 999999 || text[0] == '+' || text[0] == '-')
-        throw ParamError("frames", "--frames \"" + whole +
+        throw ParamError("frames", "--frames \"" + inputExcerpt(whole) +
                                        "\": expected FIRST-LAST with whole frame numbers from 0 to 999999, e.g. 1-48");
     return int(value);
 }
@@ -194,7 +195,7 @@ Params BakeFlags::load() const {
                 if (!hasGrid(bake, grid)) bake.grids.push_back(grid);
             }
             if (!known)
-                throw ParamError("bake.grids", "--grids: unknown grid \"" + name +
+                throw ParamError("bake.grids", "--grids: unknown grid \"" + inputExcerpt(name) +
                                                    "\" (grids: surface, density, color, trap, iterations)");
             start = comma + 1;
         }
@@ -210,7 +211,7 @@ std::optional<FrameRange> BakeFlags::frameRange() const {
     range.first = parseFrame(frames.substr(0, dash), frames);
     range.last = dash == std::string::npos ? range.first : parseFrame(frames.substr(dash + 1), frames);
     if (range.last < range.first)
-        throw ParamError("frames", "--frames \"" + frames +
+        throw ParamError("frames", "--frames \"" + inputExcerpt(frames) +
                                        "\": the last frame comes before the first; write FIRST-LAST, e.g. 1-48");
     return range;
 }
@@ -218,7 +219,7 @@ std::optional<FrameRange> BakeFlags::frameRange() const {
 std::uint64_t BakeFlags::memoryLimit() const {
     if (maxMemory.empty()) return 0;
     const std::string message =
-        "--max-memory \"" + maxMemory + "\": expected a size such as 512M, 4G or 1.5G (or bytes)";
+        "--max-memory \"" + inputExcerpt(maxMemory) + "\": expected a size such as 512M, 4G or 1.5G (or bytes)";
     std::size_t used = 0;
     double value = 0.0;
     try {

@@ -13,10 +13,12 @@
 #include <filesystem>
 #include <iostream>
 #include <map>
+#include <system_error>
 
 #include "atomic_file.hpp"
 #include "dqjulia/estimate.hpp"
 #include "file_names.hpp"
+#include "message_text.hpp"
 
 namespace dqj::cli {
 namespace {
@@ -123,10 +125,10 @@ CLI::Validator existingFile() {
             try {
                 status = std::filesystem::status(pathFromUtf8(name), error);
             } catch (const std::filesystem::filesystem_error&) {
-                return "File name is not valid UTF-8: " + name;
+                return "File name is not valid UTF-8: " + inputExcerpt(name);
             }
-            if (!std::filesystem::exists(status)) return "File does not exist: " + name;
-            if (std::filesystem::is_directory(status)) return "File is actually a directory: " + name;
+            if (!std::filesystem::exists(status)) return "File does not exist: " + inputExcerpt(name);
+            if (std::filesystem::is_directory(status)) return "File is actually a directory: " + inputExcerpt(name);
             return "";
         },
         "FILE", "EXISTING_FILE");
@@ -184,7 +186,7 @@ void FractalOptions::applyTo(Params& params) const {
         }
         if (!first || !second || *first == *second || !numberOk)
             throw ParamError("slice.rotations",
-                             "--rotate \"" + text +
+                             "--rotate \"" + inputExcerpt(text) +
                                  "\": expected PLANE:DEGREES with two different axes, e.g. a.j,b.s:30");
         params.slice.rotations.push_back({*first, *second, degrees});
     }
@@ -208,24 +210,26 @@ void checkOutputPath(const std::string& path, bool force, const std::string& fla
     if (path.empty()) throw ParamError("output.path", flag + " is empty; give a file name");
 #ifdef _WIN32
     if (const std::string problem = windowsNameProblem(path); !problem.empty())
-        throw ParamError("output.path", flag + " '" + path + "': " + problem);
+        throw ParamError("output.path", flag + " '" + inputExcerpt(path) + "': " + problem);
 #endif
     const fs::path target = pathFromUtf8(path);
+    const std::string shown = inputExcerpt(path);
     if (fs::is_directory(target, error))
-        throw ParamError("output.path", flag + " '" + path + "' is a folder; give a file name");
+        throw ParamError("output.path", flag + " '" + shown + "' is a folder; give a file name");
     if (fs::exists(target, error) && !fs::is_regular_file(target, error))
-        throw ParamError("output.path", flag + " '" + path +
+        throw ParamError("output.path", flag + " '" + shown +
                                             "' is not a regular file (a device, FIFO or socket); "
                                             "dqjulia writes only regular files");
     if (fs::exists(target, error) && !force)
-        throw ParamError("output.path", flag + " '" + path + "' exists; pass --force to overwrite it");
+        throw ParamError("output.path", flag + " '" + shown + "' exists; pass --force to overwrite it");
     const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
     if (!fs::is_directory(folder, error))
-        throw ParamError("output.path",
-                         flag + " '" + path + "': the folder '" + utf8FromPath(folder) + "' does not exist");
+        throw ParamError("output.path", flag + " '" + shown + "': the folder '" + inputExcerpt(utf8FromPath(folder)) +
+                                            "' does not exist");
 #ifndef _WIN32  // Windows: access() does not read a folder's permissions (ACLs); the probe below tries
     if (::access(folder.c_str(), W_OK) != 0)
-        throw ParamError("output.path", flag + " '" + path + "': the folder '" + folder.string() + "' is not writable");
+        throw ParamError("output.path",
+                         flag + " '" + shown + "': the folder '" + inputExcerpt(folder.string()) + "' is not writable");
 #endif
     try {
         checkWritable(path);  // not a device or FIFO, and a file can really be created there
@@ -244,7 +248,7 @@ void checkDistinctOutputs(const std::vector<NamedPath>& outputs) {
         const auto [at, added] = seen.emplace(error ? pathFromUtf8(path).lexically_normal() : canonical, index);
         if (!added)
             throw ParamError("output.path", outputs[at->second].flag + " and " + outputs[index].flag + " both name '" +
-                                                path + "'; give them different files");
+                                                inputExcerpt(path) + "'; give them different files");
     }
 }
 
@@ -259,8 +263,8 @@ void checkInputsKept(const std::vector<NamedPath>& outputs, const std::vector<Na
         if (found == read.end()) continue;
         const NamedPath& input = *found->second;
         throw ParamError("output.path",
-                         output.flag + " '" + output.path + "' is " +
-                             (input.path == output.path ? "" : "the same file as ") + input.flag + " '" + input.path +
+                         output.flag + " '" + inputExcerpt(output.path) + "' is " +
+                             (input.path == output.path ? "" : "the same file as ") + input.flag + " '" + inputExcerpt(input.path) +
                              "', which this run reads: a run never writes over its own input, not even with "
                              "--force; write to another name");
     }
@@ -309,13 +313,21 @@ int reportErrors(const std::string& command, const std::function<int()>& body) {
             std::cerr << "dqjulia " << command << ": " << param->what() << "\n";
             return kBadInput;
         }
+        const auto* system = dynamic_cast<const std::system_error*>(&error);
+        if (system && (system->code() == std::errc::resource_unavailable_try_again ||
+                       system->code() == std::errc::not_enough_memory)) {
+            std::cerr << "dqjulia " << command << ": " << exceptionMessage(error)
+                      << ": the system refused this process a thread or memory (see ulimit -u, ulimit -v and the "
+                         "container's limits); a retry may help\n";
+            return kFailure;
+        }
         if (dynamic_cast<const std::bad_alloc*>(&error)) {
             std::cerr << "dqjulia " << command
                       << ": out of memory: the work needs more memory than this process may use (see ulimit -v and the "
                          "container's memory limit); try a smaller resolution or size\n";
             return kFailure;
         }
-        std::cerr << "dqjulia " << command << ": " << error.what() << "\n";
+        std::cerr << "dqjulia " << command << ": " << exceptionMessage(error) << "\n";
         return kFailure;
     }
 }

@@ -71,11 +71,14 @@ private:
 /// Splits at "\n" and wraps at spaces (or anywhere, for long words) to `maxWidth` pixels.
 std::vector<std::string> wrap(Font& font, const std::string& label, int maxWidth) {
     std::vector<std::string> lines;
+    // badbit: memory running out ends these loops with bad_alloc, not as the text's end.
     std::istringstream paragraphs(label);
+    paragraphs.exceptions(std::ios::badbit);
     std::string paragraph;
     while (std::getline(paragraphs, paragraph)) {
         std::string line;
         std::istringstream words(paragraph);
+        words.exceptions(std::ios::badbit);
         std::string word;
         while (words >> word) {
             const std::string candidate = line.empty() ? word : line + " " + word;

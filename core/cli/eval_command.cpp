@@ -1,11 +1,12 @@
 // dqjulia eval: points on stdin, escape count and distance estimate as CSV on stdout.
 #include <cstdio>
 #include <iostream>
-#include <sstream>
 
 #include "commands.hpp"
 #include "common.hpp"
 #include "dqjulia/estimate.hpp"
+#include "message_text.hpp"
+#include "text_input.hpp"
 
 namespace dqj::cli {
 namespace {
@@ -15,23 +16,26 @@ struct EvalOptions {
     bool sliceCoords = false;
 };
 
-/// Numbers separated by spaces, tabs or commas; false if anything else is on the line.
+/// The longest line of points read: a line holds 8 numbers (a few hundred bytes), or a comment.
+constexpr std::size_t kMaxLineBytes = std::size_t(1) << 16;
+
+/// Numbers separated by spaces, tabs, commas or semicolons; false if anything else is on the line.
 bool parseNumbers(const std::string& line, std::vector<double>& numbers) {
     numbers.clear();
-    std::string text = line;
-    for (char& ch : text)
-        if (ch == ',' || ch == '\t' || ch == ';') ch = ' ';
-    std::istringstream in(text);
-    std::string word;
-    while (in >> word) {
+    const char* const separators = " \t,;";
+    for (std::size_t start = line.find_first_not_of(separators); start != std::string::npos;) {
+        const std::size_t end = std::min(line.find_first_of(separators, start), line.size());
         try {
+            const std::string word = line.substr(start, end - start);
             std::size_t used = 0;
-            const double value = std::stod(word, &used);
+            numbers.push_back(std::stod(word, &used));
             if (used != word.size()) return false;
-            numbers.push_back(value);
-        } catch (const std::exception&) {
+        } catch (const std::invalid_argument&) {
+            return false;
+        } catch (const std::out_of_range&) {
             return false;
         }
+        start = line.find_first_not_of(separators, end);
     }
     return true;
 }
@@ -40,18 +44,27 @@ int runEval(const EvalOptions& options) {
     const Params params = options.fractal.load();
     const Slice slice = params.slice.effective();
     const std::size_t expected = options.sliceCoords ? 3 : 8;
+    const std::string what = options.sliceCoords ? " (x y z)" : " (a's s i j k, then b's s i j k)";
     std::printf("n,r,ra,rb,de\n");
+    // The rows go out as the points come in; a bad line or a read error ends the output there,
+    // with the message and a failing exit status (2 or 1), never as if the input had ended.
+    LineReader input(0, "standard input", kMaxLineBytes);
     std::string line;
     std::vector<double> numbers;
-    for (std::size_t lineNumber = 1; std::getline(std::cin, line); ++lineNumber) {
-        const std::size_t start = line.find_first_not_of(" \t\r");
+    for (LineReader::Result result; (result = input.next(line)) != LineReader::Result::End;) {
+        const std::string where = "standard input, line " + std::to_string(input.lineNumber());
+        if (result == LineReader::Result::TooLong) {
+            std::fflush(stdout);
+            throw ParamError("", where + ": longer than " + std::to_string(kMaxLineBytes) +
+                                     " bytes, the most a line of " + std::to_string(expected) +
+                                     " numbers may have; it starts \"" + inputExcerpt(line, false) + "\"");
+        }
+        const std::size_t start = line.find_first_not_of(" \t");
         if (start == std::string::npos || line[start] == '#') continue;
         if (!parseNumbers(line, numbers) || numbers.size() != expected) {
             std::fflush(stdout);
-            throw ParamError("", "stdin line " + std::to_string(lineNumber) + ": expected " + std::to_string(expected) +
-                                     " numbers" +
-                                     (options.sliceCoords ? " (x y z)" : " (a's s i j k, then b's s i j k)") +
-                                     ", got \"" + line + "\"");
+            throw ParamError("", where + ": expected " + std::to_string(expected) + " numbers" + what + ", got \"" +
+                                     inputExcerpt(line) + "\"");
         }
         DualQuat point;
         if (options.sliceCoords) {

@@ -12,6 +12,7 @@
 #include "dqjulia/render.hpp"
 #include "file_names.hpp"
 #include "image_writer.hpp"
+#include "message_text.hpp"
 
 namespace dqj::cli {
 namespace {
@@ -54,22 +55,22 @@ int runExplore(const ExploreCommandOptions& options) {
     // link in its place); the folders made here are removed again unless the run publishes its files.
 #ifdef _WIN32
     if (const std::string problem = windowsNameProblem(options.folder); !problem.empty())
-        throw ParamError("output.path", "--output '" + options.folder + "': " + problem);
+        throw ParamError("output.path", "--output '" + inputExcerpt(options.folder) + "': " + problem);
 #endif
     std::error_code error;
     if (fs::is_symlink(folder, error) && !fs::exists(folder, error))
-        throw ParamError("output.path", "--output '" + options.folder + "' is a symbolic link to '" +
+        throw ParamError("output.path", "--output '" + inputExcerpt(options.folder) + "' is a symbolic link to '" +
                                             utf8FromPath(fs::read_symlink(folder, error)) +
                                             "', which does not exist; give a folder");
     if (fs::exists(folder, error) && !fs::is_directory(folder, error))
         throw ParamError("output.path",
-                         "--output '" + options.folder + "' is a file, not a folder; explore writes a folder of files");
+                         "--output '" + inputExcerpt(options.folder) + "' is a file, not a folder; explore writes a folder of files");
     MadeFolders made;  // declared before the files: removed after their temporary files
     for (fs::path at = folder; !at.empty() && !fs::exists(at, error); at = at.parent_path()) made.paths.push_back(at);
     fs::create_directories(folder, error);
     if (error)
         throw ParamError("output.path",
-                         "--output '" + options.folder + "': cannot create the folder: " + error.message());
+                         "--output '" + inputExcerpt(options.folder) + "': cannot create the folder: " + error.message());
     // The sheet and every tile's picture and parameter file: checked now, published together at the end.
     auto tileName = [](std::size_t index) {
         char name[32];

@@ -117,7 +117,7 @@ FarmPlan plan(const FarmFlags& flags, std::vector<NamedPath> jobFiles) {
     const Params& params = plan.params;
     plan.output = utf8FromPath(fs::absolute(pathFromUtf8(bake.output)).lexically_normal());
     if (AtomicFile::lowercaseExtension(plan.output) != ".vdb")
-        throw ParamError("output.path", "--output '" + bake.output + "' must end in .vdb");
+        throw ParamError("output.path", "--output '" + inputExcerpt(bake.output) + "' must end in .vdb");
     plan.frames = bake.frameRange();
     plan.chunk = flags.chunk;
     plan.tiling = bake.tiling();

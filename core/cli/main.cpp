@@ -1,4 +1,5 @@
 // dqjulia: render, evaluate and inspect dual-quaternion Julia fractals from the command line.
+#include <cstdio>
 #include <iostream>
 #include <map>
 #include <string>
@@ -11,8 +12,40 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "dqjulia/dqjulia.h"
+#include "message_text.hpp"
 
 namespace {
+
+/// The argument parser's message `message` as dqjulia shows it: printable (newlines kept), and each argument
+/// longer than an excerpt that it quotes (whole, or its value after "--flag=") shown as
+/// inputExcerpt() shows it, with its length; the parser quotes what it was given whole.
+std::string parserMessage(const std::string& message, int argc, char** argv) {
+    std::vector<std::string> quoted;
+    for (int index = 1; index < argc; ++index) {
+        const std::string argument = argv[index];
+        const std::size_t equals = argument.find('=');
+        for (const std::string& part :
+             {argument, equals == std::string::npos ? std::string() : argument.substr(equals + 1)})
+            if (dqj::inputExcerpt(part) != dqj::printableText(part)) quoted.push_back(part);
+    }
+    std::string shown;
+    for (std::size_t at = 0; at < message.size();) {
+        std::size_t next = message.size();
+        const std::string* found = nullptr;
+        for (const std::string& part : quoted) {  // the earliest, and of those the longest
+            const std::size_t position = message.find(part, at);
+            if (position < next || (position == next && found && part.size() > found->size())) {
+                next = position;
+                found = &part;
+            }
+        }
+        shown += dqj::printableText(std::string_view(message).substr(at, next - at));
+        if (!found) break;
+        shown += dqj::inputExcerpt(*found);
+        at = next + found->size();
+    }
+    return shown;
+}
 
 int run(int argc, char** argv) {
     using namespace dqj::cli;
@@ -41,13 +74,34 @@ int run(int argc, char** argv) {
     } catch (const CLI::CallForVersion& version) {
         return app.exit(version);
     } catch (const CLI::ParseError& error) {
-        app.exit(error);  // prints the message and a hint to use --help
+        // CLI11's message and hint to use --help, as app.exit(error) prints them, bounded.
+        std::cerr << parserMessage(CLI::FailureMessage::simple(&app, error), argc, argv);
         return kBadInput;
     }
     installInterruptHandlers();
     for (const auto& [command, runner] : runners)
         if (command->parsed()) return runner();
     return kBadInput;
+}
+
+/// run(), with what escapes it (the argument parser running out of memory, say) reported as a
+/// failure: an exception leaving main would end the process in std::terminate (exit 134).
+int runReported(int argc, char** argv) {
+    try {
+        return run(argc, argv);
+    } catch (const std::bad_alloc&) {
+        std::fputs(
+            "dqjulia: out of memory: this process may not use enough memory to start the work (see ulimit -v "
+            "and the container's memory limit)\n",
+            stderr);
+    } catch (const std::exception& error) {
+        try {
+            std::fprintf(stderr, "dqjulia: %s\n", dqj::printableText(error.what()).c_str());
+        } catch (const std::bad_alloc&) {
+            std::fputs("dqjulia: out of memory\n", stderr);
+        }
+    }
+    return dqj::cli::kFailure;
 }
 
 }  // namespace
@@ -69,8 +123,8 @@ int wmain(int argc, wchar_t** wideArgv) {
     for (std::string& argument : arguments) argv.push_back(argument.data());
     argv.push_back(nullptr);
     ::SetConsoleOutputCP(CP_UTF8);
-    return run(argc, argv.data());
+    return runReported(argc, argv.data());
 }
 #else
-int main(int argc, char** argv) { return run(argc, argv); }
+int main(int argc, char** argv) { return runReported(argc, argv); }
 #endif

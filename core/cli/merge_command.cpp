@@ -10,6 +10,7 @@
 #include "dqjulia/threads.hpp"
 #include "dqjulia/tiles.hpp"
 #include "file_names.hpp"
+#include "message_text.hpp"
 
 namespace dqj::cli {
 namespace {
@@ -40,8 +41,8 @@ int runMerge(const MergeFlags& flags) {
         if (bake.skips(path)) continue;
         std::string missing;
         for (const std::string& input : inputs)
-            if (!std::filesystem::is_regular_file(pathFromUtf8(input)))
-                missing += (missing.empty() ? "'" : ", '") + input + "'";
+            if (std::error_code error; !std::filesystem::is_regular_file(pathFromUtf8(input), error))
+                missing += (missing.empty() ? "'" : ", '") + inputExcerpt(input) + "'";
         if (!missing.empty())
             throw ParamError("tiles", "no tile " + missing + ": bake it first (dqjulia bake --tiles)");
         outputs.push_back({"--output", path});
@@ -49,12 +50,13 @@ int runMerge(const MergeFlags& flags) {
         merges.emplace_back(path, std::move(inputs));
     }
     checkOutputs(outputs, tiles, bake.force);
+    const std::uint64_t memoryLimit = bake.memoryLimit();
     const ThreadLimit threads(bake.threadCount());
     for (const auto& [path, inputs] : merges) {
         MergeStats stats;
         {
             ProgressBar bar(merges.size() > 1 ? "merging " + path : "merging", bake.quiet);
-            stats = mergeTiles(inputs, path, existingPolicy(bake.force), bar.callback());
+            stats = mergeTiles(inputs, path, existingPolicy(bake.force), bar.callback(), memoryLimit);
             bar.finish();
         }
         if (!bake.quiet)
@@ -86,6 +88,8 @@ Runner addMergeCommand(CLI::App& app) {
         ->add_option("--threads", flags->bake.threads,
                      "Threads to use (default: SLURM_CPUS_PER_TASK, else the CPUs this process may run on)")
         ->check(CLI::Range(1, 4096));
+    command->add_option("--max-memory", flags->bake.maxMemory,
+                        "Refuse when the estimate exceeds this, e.g. 4G or 512M (default: half the available memory)");
     command->add_flag("--skip-existing", flags->bake.skipExisting, "Skip the outputs that exist: they are complete");
     command->add_flag("-f,--force", flags->bake.force, "Overwrite existing output files");
     command->add_flag("-q,--quiet", flags->bake.quiet, "No progress bar or summary");

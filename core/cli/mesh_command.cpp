@@ -9,6 +9,7 @@
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/mesh.hpp"
 #include "dqjulia/threads.hpp"
+#include "message_text.hpp"
 
 namespace dqj::cli {
 namespace {
@@ -18,7 +19,7 @@ int runMesh(const BakeFlags& flags) {
     std::string extension = flags.output.size() >= 4 ? flags.output.substr(flags.output.size() - 4) : "";
     for (char& ch : extension) ch = char(std::tolower(static_cast<unsigned char>(ch)));
     if (extension != ".ply" && extension != ".obj")
-        throw ParamError("output.path", "--output '" + flags.output + "' must end in .ply or .obj");
+        throw ParamError("output.path", "--output '" + inputExcerpt(flags.output) + "' must end in .ply or .obj");
     const std::uint64_t memoryLimit = flags.memoryLimit();
 
     flags.checkExistingFlags();

@@ -9,6 +9,8 @@
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/povray.hpp"
 #include "file_names.hpp"
+#include "message_text.hpp"
+#include "text_input.hpp"
 
 namespace dqj::cli {
 namespace {
@@ -65,14 +67,14 @@ int runPovray(const PovrayOptions& options) {
     checkDistinctOutputs(all);
     for (const NamedPath& output : outputs) checkOutputPath(output.path, options.force, output.flag);
     if (!files.include.empty()) {
-        std::ifstream existing(pathFromUtf8(files.include), std::ios::binary);
-        std::ostringstream text;
-        text << existing.rdbuf();
-        if (existing && text.str() != povrayInclude() && !options.force)
-            throw ParamError("output.path", "'" + files.include +
+        std::error_code error;
+        const bool regular = std::filesystem::is_regular_file(pathFromUtf8(files.include), error);
+        const bool same = regular && fileHolds(files.include, povrayInclude()) == true;
+        if (regular && !same && !options.force)
+            throw ParamError("output.path", "'" + inputExcerpt(files.include) +
                                                 "' exists and differs from this version's dqjulia.inc; pass --force to "
                                                 "replace it, or --no-include to keep it");
-        if (!existing) checkOutputPath(files.include, options.force);
+        if (!same) checkOutputPath(files.include, options.force);
     }
     if (files.scene.empty())
         std::cerr << "dqjulia povray: N = " << params.fractal.iterations

@@ -13,6 +13,7 @@
 #include <openvdb/openvdb.h>
 
 #include "dqjulia/coloring.hpp"
+#include "message_text.hpp"
 #include "parallel_progress.hpp"
 #include "vdb_file.hpp"
 
@@ -24,7 +25,8 @@ constexpr int kTileRows = 8;
 openvdb::FloatGrid::ConstPtr readDensity(const std::string& path) {
     auto grid = openvdb::gridPtrCast<openvdb::FloatGrid>(findGrid(readVdbFile(path), "density"));
     if (!grid)
-        throw std::runtime_error("'" + path + "' has no float grid named \"density\" (bake it with dqjulia bake)");
+        throw std::runtime_error("'" + inputExcerpt(path) +
+                                 "' has no float grid named \"density\" (bake it with dqjulia bake)");
     return grid;
 }
 

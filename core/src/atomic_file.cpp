@@ -16,7 +16,7 @@
 #include <cstring>
 #include <ctime>
 #include <filesystem>
-#include <fstream>
+#include <optional>
 #include <random>
 #include <stdexcept>
 #include <streambuf>
@@ -36,6 +36,7 @@
 #endif
 
 #include "file_names.hpp"
+#include "text_input.hpp"
 
 namespace dqj {
 namespace {
@@ -76,12 +77,8 @@ int processId() { return int(::getpid()); }
 /// The process umask, read without changing it: umask() can only be read by setting it,
 /// which would race with other threads creating files. Linux reports it in /proc.
 mode_t currentUmask() {
-    std::ifstream status("/proc/self/status");
-    std::string line;
-    while (std::getline(status, line)) {
-        if (line.rfind("Umask:", 0) == 0) return static_cast<mode_t>(std::stoul(line.substr(6), nullptr, 8));
-    }
-    return 022;
+    const std::optional<std::string> umask = lineStartingWith("/proc/self/status", "Umask:");
+    return umask ? static_cast<mode_t>(std::strtoul(umask->c_str(), nullptr, 8)) : 022;
 }
 #endif
 
@@ -376,27 +373,6 @@ std::string windowsComponentProblem(const std::string& name) {
 
 }  // namespace
 
-std::string printableText(const std::string& text) {
-    std::string result;
-    result.reserve(text.size());
-    for (std::size_t index = 0; index < text.size(); ++index) {
-        const auto byte = static_cast<unsigned char>(text[index]);
-        const auto next = index + 1 < text.size() ? static_cast<unsigned char>(text[index + 1]) : 0;
-        char escaped[16];
-        if ((byte < 0x20 && byte != '\n' && byte != '\t') || byte == 0x7f) {
-            std::snprintf(escaped, sizeof escaped, "\\x%02x", byte);
-            result += escaped;
-        } else if (byte == 0xc2 && next >= 0x80 && next <= 0x9f) {  // a C1 control in UTF-8
-            std::snprintf(escaped, sizeof escaped, "\\xc2\\x%02x", next);
-            result += escaped;
-            ++index;
-        } else {
-            result += text[index];
-        }
-    }
-    return result;
-}
-
 std::optional<FileIdentity> fileIdentity(const std::string& path) {
 #ifdef _WIN32
     HANDLE handle = INVALID_HANDLE_VALUE;
@@ -458,7 +434,7 @@ std::string windowsNameProblem(const std::string& path) {
 }
 
 std::string AtomicFile::failureMessage(const std::string& path, const std::string& reason) {
-    return printableText("cannot write '" + path + "': " + reason);
+    return printableText("cannot write '" + inputExcerpt(path) + "': " + reason);
 }
 
 AtomicFile::AtomicFile(std::string path, Existing existing)

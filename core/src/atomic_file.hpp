@@ -23,13 +23,9 @@
 #include <vector>
 
 #include "dqjulia/params.hpp"  // Existing
+#include "message_text.hpp"    // printableText, inputExcerpt
 
 namespace dqj {
-
-/// `text` with NUL and the other control characters except newline and tab written as \xNN (the
-/// C1 controls U+0080 to U+009F, which some terminals obey as ESC sequences, as \xc2\xNN), so a
-/// message printed through a C string is never cut short and cannot drive a terminal.
-std::string printableText(const std::string& text);
 
 /// What identifies a file whatever names it (symbolic and hard links included): device and
 /// inode on POSIX, volume serial number and file index on Windows.

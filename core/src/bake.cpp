@@ -5,10 +5,10 @@
 #include "dqjulia/coloring.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -35,6 +35,7 @@
 #include "mesh_distance.hpp"
 #include "nearest_seed.hpp"
 #include "parallel_progress.hpp"
+#include "text_input.hpp"
 #include "thread_scratch.hpp"
 #include "tile_geometry.hpp"
 #include "vdb_file.hpp"
@@ -287,21 +288,17 @@ std::uint64_t defaultMemoryLimit() {
 
 namespace {
 
-/// A number from a one-line file ("max" and unreadable files: nullopt).
+/// The number a file holds ("max", no number and missing files: nullopt; a read error throws).
 std::optional<std::uint64_t> readNumberFile(const std::string& path) {
-    std::ifstream file(path);
-    std::uint64_t value = 0;
-    if (!(file >> value)) return std::nullopt;
-    return value;
+    const std::optional<std::string> text = lineStartingWith(path, "");
+    if (!text || text->empty() || !std::isdigit(static_cast<unsigned char>(text->front()))) return std::nullopt;
+    return std::strtoull(text->c_str(), nullptr, 10);
 }
 
 /// "VmSize:  123 kB" from /proc/self/status, in bytes.
 std::uint64_t statusBytes(const std::string& key) {
-    std::ifstream status("/proc/self/status");
-    std::string line;
-    while (std::getline(status, line))
-        if (line.rfind(key, 0) == 0) return std::strtoull(line.c_str() + key.size(), nullptr, 10) * 1024;
-    return 0;
+    const std::optional<std::string> value = lineStartingWith("/proc/self/status", key);
+    return value ? std::strtoull(value->c_str(), nullptr, 10) * 1024 : 0;
 }
 
 std::uint64_t headroom(std::uint64_t limit, std::uint64_t used) { return limit > used ? limit - used : 0; }
@@ -316,9 +313,10 @@ std::uint64_t processMemoryHeadroom() {
     if (::getrlimit(RLIMIT_DATA, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY)
         result = std::min(result, headroom(limit.rlim_cur, statusBytes("VmData:")));
     // Every cgroup from ours up to the root may cap us ("0::/a/b" for v2, "N:memory:/a/b" for v1).
-    std::ifstream cgroups("/proc/self/cgroup");
-    std::string line;
-    while (std::getline(cgroups, line)) {
+    const std::string cgroups = readSmallFile("/proc/self/cgroup", std::size_t(1) << 20).value_or("");
+    for (std::size_t start = 0, end = 0; start < cgroups.size(); start = end + 1) {
+        end = std::min(cgroups.find('\n', start), cgroups.size());
+        const std::string line = cgroups.substr(start, end - start);
         const std::size_t first = line.find(':'), second = line.find(':', first + 1);
         if (first == std::string::npos || second == std::string::npos) continue;
         const std::string controllers = line.substr(first + 1, second - first - 1);
@@ -340,17 +338,8 @@ std::uint64_t processMemoryHeadroom() {
 }
 
 std::uint64_t defaultMemoryLimit() {
-    std::ifstream meminfo("/proc/meminfo");
-    std::string key;
-    std::uint64_t kilobytes = 0;
-    std::string unit;
-    std::uint64_t half = 0;
-    while (meminfo >> key >> kilobytes >> unit) {
-        if (key == "MemAvailable:") {
-            half = kilobytes * 1024 / 2;
-            break;
-        }
-    }
+    const std::optional<std::string> available = lineStartingWith("/proc/meminfo", "MemAvailable:");
+    std::uint64_t half = available ? std::strtoull(available->c_str(), nullptr, 10) * 1024 / 2 : 0;
     if (half == 0) {
         const long pages = ::sysconf(_SC_AVPHYS_PAGES);
         const long pageSize = ::sysconf(_SC_PAGESIZE);
@@ -390,7 +379,7 @@ BakeStats bakeVdb(const Params& params, const std::string& path, const BakeOptio
     const auto start = std::chrono::steady_clock::now();
     validate(params);
     if (AtomicFile::lowercaseExtension(path) != ".vdb")
-        throw ParamError("output.path", "'" + path + "' must end in .vdb");
+        throw ParamError("output.path", "'" + inputExcerpt(path) + "' must end in .vdb");
     if (options.tile) checkTile(params, *options.tile);
     AtomicFile file(path, options.existing);  // fails now, before the work, if the folder is not writable
     StagedProgress staged(progress, options.monitor);
@@ -426,7 +415,11 @@ BakeStats bakeVdb(const Params& params, const std::string& path, const BakeOptio
     const std::string document = toJson(params);
     metadata.insertMeta("dqjulia_parameters", openvdb::StringMetadata(document));
     metadata.insertMeta("dqjulia_voxel_size", openvdb::DoubleMetadata(stats.voxelSize));
-    if (options.tile) addTileMetadata(metadata, params, *options.tile, document);
+    if (options.tile) {
+        std::uint64_t gridBytes = 0;
+        for (const openvdb::GridBase::Ptr& grid : grids) gridBytes += grid->memUsage();
+        addTileMetadata(metadata, params, *options.tile, document, gridBytes);
+    }
     writeVdbFile(file, grids, metadata);
     stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (progress) progress(1.0);

@@ -13,6 +13,7 @@
 #include <new>
 #include <string>
 #include <memory>
+#include <system_error>
 #include <unordered_map>
 
 #include "dqjulia/bake.hpp"
@@ -21,6 +22,7 @@
 #include "dqjulia/mesh.hpp"
 #include "dqjulia/params.hpp"
 #include "dqjulia/render.hpp"
+#include "message_text.hpp"
 
 struct dqj_context_t {
     dqj::Params params;
@@ -77,7 +79,9 @@ public:
     ~BusyScope() {
         if (!context_) return;
         std::lock_guard lock(registryMutex);
-        registry().at(handleValue(handle_)).busy = false;
+        // find(), not at(): nothing may throw from a destructor (dqj_context_destroy refuses a busy context).
+        const auto it = registry().find(handleValue(handle_));
+        if (it != registry().end()) it->second.busy = false;
     }
     BusyScope(const BusyScope&) = delete;
     BusyScope& operator=(const BusyScope&) = delete;
@@ -89,6 +93,11 @@ private:
     dqj_context_t* context_ = nullptr;
     bool busy_ = false;
 };
+
+/// The system refusing a thread or memory (ulimit -u, ulimit -v): not a file's fault.
+bool refusedResources(const std::system_error& error) {
+    return error.code() == std::errc::resource_unavailable_try_again || error.code() == std::errc::not_enough_memory;
+}
 
 /// Runs `body` for a live, idle context, mapping every exception to a status and a message.
 template <typename Body>
@@ -114,8 +123,8 @@ dqj_status guarded(dqj_context handle, Body&& body) {
         context->error = "out of memory";
         return DQJ_ERROR_OUT_OF_MEMORY;
     } catch (const std::system_error& error) {
-        context->error = error.what();
-        return DQJ_ERROR_IO;
+        context->error = dqj::exceptionMessage(error);
+        return refusedResources(error) ? DQJ_ERROR_OUT_OF_MEMORY : DQJ_ERROR_IO;
     } catch (const std::exception& error) {
         context->error = error.what();
         return DQJ_ERROR_INTERNAL;
@@ -179,6 +188,10 @@ dqj_status withFileErrors(dqj_context_t& context, Work&& work) {
         throw;
     } catch (const dqj::Cancelled&) {
         throw;
+    } catch (const std::system_error& error) {
+        if (refusedResources(error)) throw;
+        context.error = dqj::exceptionMessage(error);
+        return DQJ_ERROR_IO;
     } catch (const std::runtime_error& error) {
         context.error = error.what();
         return DQJ_ERROR_IO;

@@ -343,7 +343,9 @@ void writeImage(const Image& image, const std::string& path, ImageFormat format,
 }
 
 Image readPng(const std::string& path) {
-    auto fail = [&](const std::string& reason) { return std::runtime_error("cannot read '" + path + "': " + reason); };
+    auto fail = [&](const std::string& reason) {
+        return std::runtime_error("cannot read '" + inputExcerpt(path) + "': " + reason);
+    };
     PngRead read;
     PngReadGuard guard{read};
     read.file = openFile(path, "rb");

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "dqjulia/param_file.hpp"
+#include "message_text.hpp"
 
 namespace dqj::json {
 
@@ -74,7 +75,10 @@ std::size_t editDistance(const std::string& a, const std::string& b) {
     return previous[b.size()];
 }
 
-std::string describe(const Json& value) { return std::string(value.type_name()) + " " + preview(value, 40); }
+std::string describe(const Json& value) {
+    if (value.is_string()) return "string \"" + inputExcerpt(value.get_ref<const std::string&>()) + "\"";
+    return std::string(value.type_name()) + " " + preview(value, 40);
+}
 
 /// Parses JSON with the limits of the format: at most kMaxParamsDepth levels of arrays and
 /// objects (deeper documents are refused before they can exhaust a stack) and no key twice in
@@ -94,14 +98,14 @@ Json parseLimited(const std::string& text, const std::string& source) {
             // Appended piece by piece: GCC 12 warns (-Wrestrict, a false positive) of "[" + ...
             if (frame.object) {
                 if (!result.empty()) result += '.';
-                result += frame.key;
+                result += inputExcerpt(frame.key);
             } else if (frame.elements > 0) {
                 result += '[';
                 result += std::to_string(frame.elements - 1);
                 result += ']';
             }
         }
-        return result.empty() ? last : last.empty() ? result : result + "." + last;
+        return result.empty() ? inputExcerpt(last) : last.empty() ? result : result + "." + inputExcerpt(last);
     };
     auto elementStarts = [&] {
         if (!frames.empty() && !frames.back().object) ++frames.back().elements;
@@ -125,7 +129,7 @@ Json parseLimited(const std::string& text, const std::string& source) {
                 if (!frame.keys.insert(frame.key).second) {
                     const std::string key = path(frame.key);
                     throw ParamError(key,
-                                     source + ": " + key + ": duplicate key \"" + frame.key +
+                                     source + ": " + key + ": duplicate key \"" + inputExcerpt(frame.key) +
                                          "\" (a key may appear once in an object; the second would replace the first)");
                 }
                 break;
@@ -155,6 +159,19 @@ std::string formatNumber(double value) {
     return number;
 }
 
+namespace {
+
+/// The parser's reason with the document's text it quotes ("last read: '...'", "parsing '1e999'":
+/// up to the rest of the document, for a string never closed) cut to an excerpt.
+std::string boundedReason(std::string reason) {
+    const std::size_t open = reason.find('\''), close = reason.rfind('\'');
+    if (open == std::string::npos || close <= open) return reason;
+    return reason.substr(0, open + 1) + inputExcerpt(std::string_view(reason).substr(open + 1, close - open - 1)) +
+           reason.substr(close);
+}
+
+}  // namespace
+
 Json parseDocument(const std::string& text, const std::string& source) {
     try {
         return parseLimited(text, source);
@@ -163,12 +180,12 @@ Json parseDocument(const std::string& text, const std::string& source) {
         const std::size_t colon = reason.find(": ");  // drop "[json.exception.parse_error.101] parse error at ...: "
         if (colon != std::string::npos) reason = reason.substr(colon + 2);
         throw ParamError("", source + ": " + lineAndColumn(text, error.byte == 0 ? 0 : error.byte - 1) +
-                                 ": malformed JSON: " + reason);
+                                 ": malformed JSON: " + boundedReason(reason));
     } catch (const Json::exception& error) {  // e.g. "number overflow parsing '1e999'"
         std::string reason = error.what();
         const std::size_t bracket = reason.find("] ");
         if (bracket != std::string::npos) reason = reason.substr(bracket + 2);
-        throw ParamError("", source + ": malformed JSON: " + reason);
+        throw ParamError("", source + ": malformed JSON: " + boundedReason(reason));
     }
 }
 

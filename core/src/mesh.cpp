@@ -325,7 +325,7 @@ Mesh bakeMesh(const Params& params, const BakeOptions& options, const ProgressCa
 void writeMesh(const Mesh& mesh, const std::string& path, Existing existing) {
     const std::string extension = AtomicFile::lowercaseExtension(path);
     if (extension != ".ply" && extension != ".obj")
-        throw ParamError("output.path", "'" + path + "' must end in .ply or .obj");
+        throw ParamError("output.path", "'" + inputExcerpt(path) + "' must end in .ply or .obj");
     AtomicFile file(path, existing);
     if (extension == ".ply")
         writePly(mesh, file.stream());

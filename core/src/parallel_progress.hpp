@@ -4,7 +4,9 @@
 // Internal to libdqjulia. The renderer runs image tiles through it, the baker slabs of a grid.
 // The calling thread only waits and calls the user's callback (at the start, a few times a
 // second and once with 1.0 at the end), so a host such as Blender sees the callback on the thread that asked
-// for the work. Cost: one extra thread per call; the items themselves run on TBB's pool.
+// for the work. Cost: one extra thread per call; the items themselves run on TBB's pool. Where
+// the system refuses that thread (the user's process limit, an address-space cap), the calling
+// thread runs items too and reports between them, so the work goes on with the threads there are.
 #pragma once
 
 #include <atomic>
@@ -14,6 +16,8 @@
 #include <exception>
 #include <functional>
 #include <mutex>
+#include <optional>
+#include <system_error>
 #include <thread>
 
 #include <tbb/blocked_range.h>
@@ -57,26 +61,37 @@ inline void parallelForWithProgress(std::size_t count, const ProgressCallback& p
     std::mutex errorMutex;
     std::exception_ptr error;
 
-    // Items never throw into TBB: the first failure is kept and the rest are skipped.
-    auto runItems = [&] {
-        tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1),
-                          [&](const tbb::blocked_range<std::size_t>& range) {
-                              for (std::size_t index = range.begin(); index != range.end(); ++index) {
-                                  if (stop.load(std::memory_order_relaxed)) return;
-                                  try {
-                                      work(index, stop);
-                                  } catch (...) {
-                                      std::lock_guard<std::mutex> lock(errorMutex);
-                                      if (!error) error = std::current_exception();
-                                      stop = true;
+    // Items never throw into TBB: the first failure is kept and the rest are skipped. `afterItem`
+    // runs on the thread that ran the item, after it. TBB itself may still throw (memory for its
+    // own tasks refused): kept as an item's failure is, since on the worker thread an exception
+    // leaving would terminate the process.
+    auto keep = [&] {
+        std::lock_guard<std::mutex> lock(errorMutex);
+        if (!error) error = std::current_exception();
+        stop = true;
+    };
+    auto runItems = [&](const std::function<void()>& afterItem) {
+        try {
+            tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1),
+                              [&](const tbb::blocked_range<std::size_t>& range) {
+                                  for (std::size_t index = range.begin(); index != range.end(); ++index) {
+                                      if (stop.load(std::memory_order_relaxed)) return;
+                                      try {
+                                          work(index, stop);
+                                          done.fetch_add(1, std::memory_order_relaxed);
+                                          if (afterItem) afterItem();
+                                      } catch (...) {
+                                          keep();
+                                      }
                                   }
-                                  done.fetch_add(1, std::memory_order_relaxed);
-                              }
-                          });
+                              });
+        } catch (...) {
+            keep();
+        }
     };
 
     if (!progress) {
-        runItems();
+        runItems({});
         if (error) std::rethrow_exception(error);
         return;
     }
@@ -87,14 +102,37 @@ inline void parallelForWithProgress(std::size_t count, const ProgressCallback& p
     std::mutex mutex;
     std::condition_variable finishedSignal;
     bool finished = false;
-    std::thread worker([&] {
-        runItems();
-        {
-            std::lock_guard<std::mutex> lock(mutex);
-            finished = true;
-        }
-        finishedSignal.notify_one();
-    });
+    std::optional<std::thread> worker;
+    try {
+        worker.emplace([&] {
+            runItems({});
+            {
+                std::lock_guard<std::mutex> lock(mutex);
+                finished = true;
+            }
+            finishedSignal.notify_one();
+        });
+    } catch (const std::system_error&) {
+        // No thread to spare: this thread runs items too, and calls the callback (on itself, as
+        // promised) after one of its items when 100 ms have passed.
+        const std::thread::id caller = std::this_thread::get_id();
+        auto last = std::chrono::steady_clock::now();
+        bool cancelled = false;
+        runItems([&] {
+            if (std::this_thread::get_id() != caller || cancelled) return;  // `cancelled`: the caller's alone
+            const auto now = std::chrono::steady_clock::now();
+            if (now - last < std::chrono::milliseconds(100)) return;
+            last = now;
+            if (!progress(static_cast<double>(done.load()) / static_cast<double>(count))) {
+                cancelled = true;
+                stop = true;
+            }
+        });
+        if (error) std::rethrow_exception(error);
+        if (cancelled) throw Cancelled();
+        progress(1.0);
+        return;
+    }
     // The worker must be joined on every path, or std::thread's destructor terminates.
     struct Joiner {
         std::thread& thread;
@@ -105,7 +143,7 @@ inline void parallelForWithProgress(std::size_t count, const ProgressCallback& p
                 thread.join();
             }
         }
-    } joiner{worker, stop};
+    } joiner{*worker, stop};
 
     bool cancelled = false;
     {
@@ -123,7 +161,7 @@ inline void parallelForWithProgress(std::size_t count, const ProgressCallback& p
             }
         }
     }
-    worker.join();
+    worker->join();
     if (error) std::rethrow_exception(error);
     if (cancelled) throw Cancelled();
     progress(1.0);  // the work is complete: a late "false" has nothing left to cancel

@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "dqjulia/param_file.hpp"
+#include "message_text.hpp"
 
 namespace dqj::detail {
 
@@ -63,7 +64,8 @@ void checkChoice(const Field& field, const Json& value, const std::string& key, 
         for (const schema::Choice& choice : field.choices)
             if (value.get<std::string>() == choice.name) return;
     fail(key, prefix,
-         "must be one of " + choiceList(field) + ", got " + (value.is_string() ? value.dump() : describe(value)));
+         "must be one of " + choiceList(field) + ", got " +
+             (value.is_string() ? "\"" + inputExcerpt(value.get_ref<const std::string&>()) + "\"" : describe(value)));
 }
 
 namespace {

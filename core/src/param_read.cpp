@@ -104,18 +104,20 @@ public:
             std::string nearest;
             std::size_t best = std::string::npos;
             for (const std::string& candidate : known_) {
+                if (item.key().size() > 2 * candidate.size() + 8) continue;  // nothing near (and a long key costs)
                 const std::size_t distance = json::editDistance(item.key(), candidate);
                 if (distance < best) {
                     best = distance;
                     nearest = candidate;
                 }
             }
-            std::string message = "unknown key \"" + item.key() + "\"";
+            const std::string key = inputExcerpt(item.key());
+            std::string message = "unknown key \"" + key + "\"";
             if (best <= std::max<std::size_t>(2, item.key().size() / 3))
                 message += "; did you mean \"" + nearest + "\"?";
             std::string allowed;
             for (const std::string& candidate : known_) allowed += (allowed.empty() ? "" : ", ") + candidate;
-            fail(keyPath(item.key()), message + " (allowed here: " + allowed + ")");
+            fail(keyPath(key), message + " (allowed here: " + allowed + ")");
         }
     }
 
@@ -177,7 +179,7 @@ void readSlice(ObjectReader reader, SliceSpec& slice) {
                 item.fail(item.keyPath("plane"),
                           "must name two different axes like \"a.j,b.s\" (axes: a.s a.i a.j a.k b.s "
                           "b.i b.j b.k), got \"" +
-                              plane + "\"");
+                              inputExcerpt(plane) + "\"");
             rotation.first = *first;
             rotation.second = *second;
             item.read("degrees", rotation.degrees);
@@ -431,9 +433,8 @@ Params readDocument(const Json& document, const std::string& source, Validation 
 }  // namespace
 
 Params loadParams(const std::string& path, Validation validation) {
-    auto fail = [&](const std::string& reason) {
-        return ParamError("", "cannot read parameter file '" + path + "': " + reason);
-    };
+    const std::string source = "parameter file '" + inputExcerpt(path) + "'";
+    auto fail = [&](const std::string& reason) { return ParamError("", "cannot read " + source + ": " + reason); };
     const int fd = openForReading(path);
     if (fd < 0) throw fail(std::strerror(errno));
     // Read at most one byte beyond the limit, so a never-ending file (/dev/zero, a stalled
@@ -449,11 +450,13 @@ Params loadParams(const std::string& path, Validation validation) {
     }
     ::close(fd);
     if (error == EINTR) throw fail("interrupted");
-    if (error) throw fail(std::strerror(error));
+    if (error == EISDIR) throw fail(std::strerror(error));  // a folder given as the file: bad input
+    // The disk or the network failing is not bad input (exit 1, DQJ_ERROR_IO): a retry may help.
+    if (error) throw std::system_error(error, std::generic_category(), printableText("cannot read " + source));
     if (text.size() > kMaxParamsBytes)
         throw fail("larger than " + std::to_string(kMaxParamsBytes >> 20) +
                    " MiB; a parameter file is a few kilobytes");
-    return parseParams(text, path, validation);
+    return parseParams(text, inputExcerpt(path), validation);
 }
 
 }  // namespace dqj

@@ -9,6 +9,7 @@
 
 #include "dqjulia/param_file.hpp"
 #include "json_text.hpp"
+#include "message_text.hpp"
 #include "param_check.hpp"
 
 namespace dqj {
@@ -104,7 +105,7 @@ void validate(const Params& params) {
         std::transform(extension.begin(), extension.end(), extension.begin(),
                        [](unsigned char ch) { return std::tolower(ch); });
         if (extension != ".png" && extension != ".exr")
-            fail("output.path", "\"" + params.output.path +
+            fail("output.path", "\"" + inputExcerpt(params.output.path) +
                                     "\" must end in .png or .exr (or set output.format to png8, png16 or exr)");
     }
 

@@ -20,6 +20,7 @@
 #include "dqjulia/render.hpp"
 #include "file_names.hpp"
 #include "parallel_progress.hpp"
+#include "text_input.hpp"
 
 namespace dqj {
 
@@ -87,6 +88,7 @@ std::string povString(std::string_view text) {
 std::string commentBlock(std::string_view text) {
     std::string out;
     std::istringstream words{std::string(text)};
+    words.exceptions(std::ios::badbit);  // memory running out ends the loop with bad_alloc, not as the text's end
     std::string word;
     std::string line = "//";
     while (words >> word) {
@@ -462,8 +464,9 @@ PovrayFiles povrayFiles(const Params& params, const std::string& scenePath, cons
         const std::string df3Name = utf8FromPath(pathFromUtf8(files.df3).filename());
         for (const char ch : df3Name)
             if (ch < 0x20 || ch > 0x7e || ch == '"' || ch == '\\')
-                throw ParamError("output.path", "'" + scenePath + "': with --df3 the scene names the grid file '" +
-                                                    df3Name +
+                throw ParamError("output.path", "'" + inputExcerpt(scenePath) +
+                                                    "': with --df3 the scene names the grid file '" +
+                                                    inputExcerpt(df3Name) +
                                                     "' in a POV-Ray string, which carries only printable ASCII "
                                                     "characters without \" and \\; rename the scene");
     }
@@ -501,10 +504,7 @@ std::vector<std::string> writePovray(const Params& params, const std::string& sc
         set.add(files.df3Scene).stream() << df3SceneText;
     }
     if (!files.include.empty()) {
-        std::ifstream existing(pathFromUtf8(files.include), std::ios::binary);
-        std::ostringstream current;
-        current << existing.rdbuf();
-        if (!existing || current.str() != povrayInclude()) set.add(files.include).stream() << povrayInclude();
+        if (fileHolds(files.include, povrayInclude()) != true) set.add(files.include).stream() << povrayInclude();
     }
     set.commit();
     return set.paths();

@@ -1,6 +1,7 @@
 // Slices: axis names, rotations, stretch, containing bounds and the bounds everything starts from.
 #include "dqjulia/slice.hpp"
 #include "dqjulia/params.hpp"
+#include "message_text.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -137,17 +138,17 @@ Slice sliceFromAxisNames(std::string_view shorthand) {
     }
     if (parts.size() != 3)
         throw std::invalid_argument("a slice names exactly 3 axes separated by commas (e.g. \"a.s,a.i,a.j\"), got " +
-                                    std::to_string(parts.size()) + " in \"" + std::string(shorthand) + "\"");
+                                    std::to_string(parts.size()) + " in \"" + inputExcerpt(shorthand) + "\"");
     Slice slice;
     std::array<int, 3> used{-1, -1, -1};
     for (int axis = 0; axis < 3; ++axis) {
         const auto index = parseAxisName(parts[axis]);
         if (!index)
-            throw std::invalid_argument("unknown axis \"" + std::string(trim(parts[axis])) +
+            throw std::invalid_argument("unknown axis \"" + inputExcerpt(trim(parts[axis])) +
                                         "\"; axes are a.s a.i a.j a.k (real part) and b.s b.i b.j b.k (dual part)");
         if (std::find(used.begin(), used.end(), *index) != used.end())
             throw std::invalid_argument("axis \"" + axisName(*index) + "\" is named twice in \"" +
-                                        std::string(shorthand) + "\"; the three axes must differ");
+                                        inputExcerpt(shorthand) + "\"; the three axes must differ");
         used[axis] = *index;
         slice.axes[axis] = Vec8{};
         slice.axes[axis][*index] = 1.0;

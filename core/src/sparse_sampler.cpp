@@ -163,9 +163,10 @@ public:
         progress_.setDense(dense_);
         std::vector<Coord> wave;
         if (options_.dense) {
-            wave = allLeaves();  // nothing to classify: every leaf is sampled
-            checkMemory(wave.size(), true);
+            checkMemory(leafCount(), true);  // before the list of them is made
+            wave = allLeaves();              // nothing to classify: every leaf is sampled
         } else {
+            checkMemory(0, false);  // the fixed part alone may exceed a small limit
             wave = classify(split);
         }
 
@@ -220,6 +221,21 @@ public:
     }
 
 private:
+    /// The leaves (or blocks of `step` voxels) along each axis that cover indexBox_.
+    std::array<std::uint64_t, 3> blocksAlong(int step) const {
+        std::array<std::uint64_t, 3> counts{};
+        for (int axis = 0; axis < 3; ++axis)
+            counts[axis] =
+                std::uint64_t((std::int64_t(indexBox_.max()[axis]) - floorTo(indexBox_.min()[axis], step)) / step + 1);
+        return counts;
+    }
+
+    /// allLeaves().size(), counted without making the list.
+    std::uint64_t leafCount() const {
+        const std::array<std::uint64_t, 3> counts = blocksAlong(kLeafSize);
+        return counts[0] * counts[1] * counts[2];
+    }
+
     std::vector<Coord> allLeaves() const {
         std::vector<Coord> leaves;
         const Coord lo = indexBox_.min(), hi = indexBox_.max();
@@ -237,24 +253,31 @@ private:
     };
 
     /// Classifies every leaf; returns the first wave to sample (surface leaves and deferred
-    /// leaves next to skipped space) after checking the memory estimate.
+    /// leaves next to skipped space) after checking the memory estimate. One work item is a
+    /// column of top blocks along z, so what the classification itself holds grows with the
+    /// surface it finds, which is checked against the limit as it grows, and with the square of
+    /// the resolution, a list per column (3 MB at 16384), never with its cube (a list per block
+    /// took 1 GB there before any check could refuse). The leaves come out in x, y, z order of
+    /// their blocks, as from a list of blocks.
     std::vector<Coord> classify(double split) {
-        std::vector<Coord> blocks;
-        const Coord lo = indexBox_.min(), hi = indexBox_.max();
-        for (int x = floorTo(lo.x(), kTopBlockSize); x <= hi.x(); x += kTopBlockSize)
-            for (int y = floorTo(lo.y(), kTopBlockSize); y <= hi.y(); y += kTopBlockSize)
-                for (int z = floorTo(lo.z(), kTopBlockSize); z <= hi.z(); z += kTopBlockSize)
-                    blocks.emplace_back(x, y, z);
-        std::vector<Lists> lists(blocks.size());
+        const Coord lo = indexBox_.min();
+        const std::array<std::uint64_t, 3> blocks = blocksAlong(kTopBlockSize);
+        const int x0 = floorTo(lo.x(), kTopBlockSize), y0 = floorTo(lo.y(), kTopBlockSize);
+        const int z0 = floorTo(lo.z(), kTopBlockSize);
+        std::vector<Lists> lists(blocks[0] * blocks[1]);
         std::atomic<std::uint64_t> surfaceLeaves{0};
-        parallelForWithProgress(blocks.size(), progress_.stage(BakeStage::Classifying, 0.0, split),
-                                [&](std::size_t index, const std::atomic<bool>&) {
+        parallelForWithProgress(lists.size(), progress_.stage(BakeStage::Classifying, 0.0, split),
+                                [&](std::size_t column, const std::atomic<bool>& stop) {
+                                    const int x = x0 + int(column / blocks[1]) * kTopBlockSize;
+                                    const int y = y0 + int(column % blocks[1]) * kTopBlockSize;
                                     std::uint64_t count = 0;
-                                    classifyBlock(blocks[index], kTopBlockSize, lists[index], count);
+                                    for (std::uint64_t k = 0; k < blocks[2] && !stop; ++k)
+                                        classifyBlock(Coord(x, y, z0 + int(k) * kTopBlockSize), kTopBlockSize,
+                                                      lists[column], count);
                                     evaluated_ += count;
                                     progress_.countEvaluations(count);
                                     // Refuse early: the surface leaves alone already exceed the limit.
-                                    const std::uint64_t total = surfaceLeaves += lists[index].surface.size();
+                                    const std::uint64_t total = surfaceLeaves += lists[column].surface.size();
                                     if (estimateFor(total) > limit_) checkMemory(total, false);
                                 });
         std::vector<Coord> wave;
@@ -368,8 +391,12 @@ private:
             "resolution " + std::to_string(params_.bake.resolution) +
                 (final ? " needs an estimated " + formatBytes(estimate) + " (" + blocks + "), more than the limit of " +
                              limit
-                       : " needs more than the limit of " + limit + ": the first " + blocks + " already need " +
-                             formatBytes(estimate)) +
+                 : leaves > 0 ? " needs more than the limit of " + limit + ": the first " + blocks + " already need " +
+                                    formatBytes(estimate)
+                              : " needs at least " + formatBytes(estimate) +
+                                    " before any voxel is sampled, more than "
+                                    "the limit of " +
+                                    limit) +
                 (processLimited_
                      ? std::string(
                            "; lower the resolution, bake a smaller region (bake.bounds) or raise the process's limit")

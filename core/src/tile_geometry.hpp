@@ -26,8 +26,9 @@ openvdb::CoordBBox keptBox(const openvdb::CoordBBox& full, const openvdb::CoordB
 openvdb::CoordBBox tileWindow(const Params& params, const Tile& tile);
 
 /// The metadata naming a tile in its file: the tiling, the tile, the whole bake's index box,
-/// the box the tile owns, the hash of `document` (the parameters, as written in the file)
-/// and dqjulia's version.
-void addTileMetadata(openvdb::MetaMap& metadata, const Params& params, const Tile& tile, const std::string& document);
+/// the box the tile owns, the hash of `document` (the parameters, as written in the file),
+/// dqjulia's version, and the memory its grids take (`gridBytes`: the merge's estimate).
+void addTileMetadata(openvdb::MetaMap& metadata, const Params& params, const Tile& tile, const std::string& document,
+                     std::uint64_t gridBytes);
 
 }  // namespace dqj

@@ -41,6 +41,7 @@ constexpr const char* kOwnedMinKey = "dqjulia_tile_min";
 constexpr const char* kOwnedMaxKey = "dqjulia_tile_max";
 constexpr const char* kHashKey = "dqjulia_parameters_hash";
 constexpr const char* kVersionKey = "dqjulia_version";
+constexpr const char* kGridBytesKey = "dqjulia_tile_grid_bytes";
 
 const char* const kAxisNames[3] = {"x", "y", "z"};
 
@@ -72,11 +73,12 @@ struct TileHeader {
     CoordBBox full, owned;
     std::string document, hash, version;
     double voxelSize = 0.0;
+    std::uint64_t gridBytes = 0;  // the memory its grids take
 };
 
 TileHeader readTileHeader(const std::string& path) {
     const openvdb::MetaMap::Ptr metadata = readVdbMetadata(path);
-    auto fail = [&](const std::string& why) { return ParamError("tiles", "'" + path + "' " + why); };
+    auto fail = [&](const std::string& why) { return ParamError("tiles", "'" + inputExcerpt(path) + "' " + why); };
     if (!(*metadata)[kTilingKey])
         throw fail("is not a tile of a dqjulia bake (no " + std::string(kTilingKey) +
                    " metadata): bake tiles with dqjulia bake --tiles AxBxC");
@@ -93,6 +95,8 @@ TileHeader readTileHeader(const std::string& path) {
         header.hash = metadata->metaValue<std::string>(kHashKey);
         header.version = metadata->metaValue<std::string>(kVersionKey);
         header.voxelSize = metadata->metaValue<double>("dqjulia_voxel_size");
+        header.gridBytes =
+            std::uint64_t(std::max<openvdb::Int64>(0, metadata->metaValue<openvdb::Int64>(kGridBytesKey)));
     } catch (const ParamError&) {
         throw fail("is a damaged tile: its tiling metadata cannot be read");
     } catch (const openvdb::Exception&) {
@@ -112,7 +116,7 @@ void checkTilesBelongTogether(const std::vector<TileHeader>& headers) {
     const TileHeader& first = headers.front();
     for (const TileHeader& header : headers) {
         if (header.version != DQJ_VERSION_STRING)
-            throw ParamError("tiles", "'" + header.path + "' was baked by dqjulia " + header.version +
+            throw ParamError("tiles", "'" + inputExcerpt(header.path) + "' was baked by dqjulia " + header.version +
                                           " and this is dqjulia " + DQJ_VERSION_STRING +
                                           ": bake and merge with the same version on every machine");
         std::string differs;
@@ -123,15 +127,16 @@ void checkTilesBelongTogether(const std::vector<TileHeader>& headers) {
         else if (header.full != first.full || header.voxelSize != first.voxelSize)
             differs = "its grid differs";
         if (!differs.empty())
-            throw ParamError("tiles", "'" + header.path + "' is not a tile of the same bake as '" + first.path +
-                                          "': " + differs);
+            throw ParamError("tiles", "'" + inputExcerpt(header.path) + "' is not a tile of the same bake as '" +
+                                          inputExcerpt(first.path) + "': " + differs);
     }
     std::map<int, const TileHeader*> byIndex;
     for (const TileHeader& header : headers) {
         const auto [at, added] = byIndex.emplace(header.tile.index, &header);
         if (!added)
-            throw ParamError("tiles", "'" + at->second->path + "' and '" + header.path + "' are both tile " +
-                                          std::to_string(header.tile.index) + " of " + tilingText(first.tile));
+            throw ParamError("tiles", "'" + inputExcerpt(at->second->path) + "' and '" + inputExcerpt(header.path) +
+                                          "' are both tile " + std::to_string(header.tile.index) + " of " +
+                                          tilingText(first.tile));
     }
     const int count = tileCount(first.tile);
     std::string missing;
@@ -152,6 +157,33 @@ void checkTilesBelongTogether(const std::vector<TileHeader>& headers) {
         throw ParamError("tiles", "the tiles' boxes do not cover the bake's box " + boxText(first.full) + " once");
 }
 
+/// Refuses (MemoryLimitError) before any grid is read a merge whose estimate exceeds the limit
+/// (`memoryLimit`, 0: defaultMemoryLimit()), or what the process may allocate. The merge holds
+/// the merged grids (as much as the tiles' grids together), one tile being merged, and the
+/// density made from the merged surface (at most as much again), besides the bake's fixed part.
+void checkMergeMemory(const std::vector<TileHeader>& headers, const Params& params, std::uint64_t memoryLimit) {
+    std::uint64_t total = 0, largest = 0;
+    for (const TileHeader& header : headers) {
+        total += header.gridBytes;
+        largest = std::max(largest, header.gridBytes);
+    }
+    const std::uint64_t estimate = (std::uint64_t(96) << 20) + 2 * total + largest;
+    const std::uint64_t processLimit = processMemoryHeadroom();
+    const std::uint64_t requested = memoryLimit ? memoryLimit : defaultMemoryLimit();
+    const std::uint64_t limit = std::min(requested, processLimit);
+    if (estimate <= limit) return;
+    const bool processLimited = processLimit <= requested;
+    throw MemoryLimitError(
+        "merging the " + std::to_string(headers.size()) + " tiles of resolution " +
+            std::to_string(params.bake.resolution) + " needs an estimated " + formatBytes(estimate) +
+            " (their grids take " + formatBytes(total) + "), more than the limit of " + formatBytes(limit) +
+            (processLimited ? " (what this process may still allocate under its memory limits: ulimit -v, ulimit -d "
+                              "or its cgroup's memory.max); merge where the process may use more memory"
+             : memoryLimit  ? "; raise the limit (--max-memory)"
+                            : " (half of the available memory); raise the limit (--max-memory)"),
+        estimate, limit);
+}
+
 }  // namespace
 
 Tile parseTiling(const std::string& text) {
@@ -168,7 +200,7 @@ Tile parseTiling(const std::string& text) {
         ok = ok && tile.counts[axis] >= 1 && tile.counts[axis] <= kMaxTilesPerAxis;
     }
     if (!ok || position != text.size())
-        throw ParamError("tiles", "tiles \"" + printableText(text) +
+        throw ParamError("tiles", "tiles \"" + inputExcerpt(text) +
                                       "\": expected AxBxC, tiles along x, y and z from 1 to " +
                                       std::to_string(kMaxTilesPerAxis) + " each, e.g. 2x2x2");
     return tile;
@@ -267,7 +299,8 @@ CoordBBox tileWindow(const Params& params, const Tile& tile) {
     return window;
 }
 
-void addTileMetadata(openvdb::MetaMap& metadata, const Params& params, const Tile& tile, const std::string& document) {
+void addTileMetadata(openvdb::MetaMap& metadata, const Params& params, const Tile& tile, const std::string& document,
+                     std::uint64_t gridBytes) {
     const CoordBBox full = bakeIndexBox(params);
     const CoordBBox owned = ownedBox(full, tile);
     metadata.insertMeta(kTilingKey, openvdb::StringMetadata(tilingText(tile)));
@@ -278,14 +311,15 @@ void addTileMetadata(openvdb::MetaMap& metadata, const Params& params, const Til
     metadata.insertMeta(kOwnedMaxKey, openvdb::Vec3IMetadata(asVec(owned.max())));
     metadata.insertMeta(kHashKey, openvdb::StringMetadata(hashText(document)));
     metadata.insertMeta(kVersionKey, openvdb::StringMetadata(DQJ_VERSION_STRING));
+    metadata.insertMeta(kGridBytesKey, openvdb::Int64Metadata(openvdb::Int64(gridBytes)));
 }
 
 MergeStats mergeTiles(const std::vector<std::string>& tiles, const std::string& path, Existing existing,
-                      const ProgressCallback& progress) {
+                      const ProgressCallback& progress, std::uint64_t memoryLimit) {
     const auto start = std::chrono::steady_clock::now();
     if (tiles.empty()) throw ParamError("tiles", "no tiles to merge");
     if (AtomicFile::lowercaseExtension(path) != ".vdb")
-        throw ParamError("output.path", "'" + path + "' must end in .vdb");
+        throw ParamError("output.path", "'" + inputExcerpt(path) + "' must end in .vdb");
     initializeOpenVdb();
     // First every tile's metadata: nothing heavy is read before the tiles are known to fit.
     std::vector<TileHeader> headers;
@@ -294,9 +328,11 @@ MergeStats mergeTiles(const std::vector<std::string>& tiles, const std::string& 
     checkTilesBelongTogether(headers);
     std::sort(headers.begin(), headers.end(),
               [](const TileHeader& a, const TileHeader& b) { return a.tile.index < b.tile.index; });
-    const Params params = parseParams(headers.front().document, "'" + headers.front().path + "'");
+    const Params params = parseParams(headers.front().document, "'" + inputExcerpt(headers.front().path) + "'");
     if (bakeIndexBox(params) != headers.front().full)
-        throw ParamError("tiles", "'" + headers.front().path + "' is a damaged tile: its box is not its bake's");
+        throw ParamError("tiles",
+                         "'" + inputExcerpt(headers.front().path) + "' is a damaged tile: its box is not its bake's");
+    checkMergeMemory(headers, params, memoryLimit);
     AtomicFile file(path, existing);  // fails now, before the work, if the folder is not writable
 
     // Then one tile at a time: its surface united into the result, its attribute voxels copied.
@@ -311,13 +347,15 @@ MergeStats mergeTiles(const std::vector<std::string>& tiles, const std::string& 
         stats.tileBytes += std::filesystem::file_size(pathFromUtf8(header.path));
         auto tileSurface = openvdb::gridPtrCast<openvdb::FloatGrid>(findGrid(contents, "surface"));
         if (!tileSurface || tileSurface->getGridClass() != openvdb::GRID_LEVEL_SET)
-            throw ParamError("tiles", "'" + header.path + "' is a damaged tile: it has no level set \"surface\"");
+            throw ParamError("tiles",
+                             "'" + inputExcerpt(header.path) + "' is a damaged tile: it has no level set \"surface\"");
         if (!surface) {
             surface = tileSurface;
         } else {
             if (tileSurface->transform() != surface->transform() || tileSurface->background() != surface->background())
-                throw ParamError("tiles", "'" + header.path + "' is a damaged tile: its grid differs from '" +
-                                              headers.front().path + "''s");
+                throw ParamError("tiles", "'" + inputExcerpt(header.path) +
+                                              "' is a damaged tile: its grid differs from '" +
+                                              inputExcerpt(headers.front().path) + "''s");
             openvdb::tools::csgUnion(surface->tree(), tileSurface->tree(), /*prune=*/false);
         }
         for (const BakeGrid grid : attributes) {
@@ -327,7 +365,8 @@ MergeStats mergeTiles(const std::vector<std::string>& tiles, const std::string& 
             const bool vector = grid == BakeGrid::Color;
             if (!part || (vector ? !openvdb::gridPtrCast<openvdb::Vec3SGrid>(part)
                                  : !openvdb::gridPtrCast<openvdb::FloatGrid>(part)))
-                throw ParamError("tiles", "'" + header.path + "' is a damaged tile: it has no grid \"" + name + "\"");
+                throw ParamError("tiles", "'" + inputExcerpt(header.path) + "' is a damaged tile: it has no grid \"" +
+                                              name + "\"");
             auto& into = merged[grid];
             if (!into)
                 into = part;

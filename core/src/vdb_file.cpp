@@ -11,6 +11,7 @@
 #include <openvdb/io/Stream.h>
 
 #include "file_names.hpp"
+#include "message_text.hpp"
 
 // Without Blosc, OpenVDB would throw only at the first leaf it compresses, in every bake.
 #ifndef OPENVDB_USE_BLOSC
@@ -108,7 +109,9 @@ namespace {
 /// `metadataOnly`.
 VdbContents readChecked(const std::string& path, bool metadataOnly) {
     openvdb::initialize();
-    auto fail = [&](const std::string& reason) { return std::runtime_error("cannot read '" + path + "': " + reason); };
+    auto fail = [&](const std::string& reason) {
+        return std::runtime_error("cannot read '" + inputExcerpt(path) + "': " + reason);
+    };
     const std::filesystem::path name = pathFromUtf8(path);  // UTF-8, on Windows too (file_names.hpp)
     std::ifstream in(name, std::ios::binary);
     if (!in) throw fail(std::strerror(errno));

@@ -1,10 +1,11 @@
 /* fault_shim.c - an LD_PRELOAD library that makes writes into one folder fail, for the
- * fault-injection tests (hostile_input_test.cpp, outputs_test.cpp).
+ * fault-injection tests (hostile_input_test.cpp, outputs_test.cpp, limits_test.cpp); and reads,
+ * and the creation of threads.
  *
- * It replaces glibc's write, fsync and close (and, for mode publish, rename, renameat2, link and
- * linkat), so it works whatever the program links
- * statically (OpenVDB, TBB, libpng) as long as glibc itself is a shared library. Only
- * descriptors whose file lies in DQJ_FAULT_DIR are touched (an O_TMPFILE shows up there as
+ * It replaces glibc's write, read, fsync, close and pthread_create (and, for mode publish, rename,
+ * renameat2, link and linkat), so it works whatever the program links statically (OpenVDB, TBB,
+ * libpng) as long as glibc itself is a shared library. Only descriptors whose file lies in
+ * DQJ_FAULT_DIR are touched (an O_TMPFILE shows up there as
  * "DIR/#123 (deleted)"); everything else passes through. Settings, from the environment:
  *   DQJ_FAULT_DIR    the folder (absolute path)
  *   DQJ_FAULT_MODE   enospc: writes fail with ENOSPC once DQJ_FAULT_AFTER bytes were written;
@@ -14,7 +15,11 @@
  *                    publish: giving a file its name there fails with EIO (rename, renameat2,
  *                            link, linkat onto a name that is not hidden, i.e. does not start
  *                            with '.'), once, after DQJ_FAULT_AFTER such names were given.
- *   DQJ_FAULT_AFTER  bytes allowed before writes fail, or names given before one fails (default 0)
+ *                    read:   reads there fail with EIO once DQJ_FAULT_AFTER bytes were read;
+ *                    threads: pthread_create fails with EAGAIN (as at the user's process limit)
+ *                            once DQJ_FAULT_AFTER threads were made, in any folder; each refusal
+ *                            adds a line to the file DQJ_FAULT_LOG, if set.
+ *   DQJ_FAULT_AFTER  bytes (threads, names given) allowed before the calls fail (default 0)
  *   DQJ_FAULT_NO_TMPFILE=1  open(O_TMPFILE) fails with EOPNOTSUPP, as on a file system
  *                    without it, so the writer's fallback (a hidden, locked name) is tested
  */
@@ -22,6 +27,8 @@
 #include <dlfcn.h>
 #include <errno.h>
 #include <fcntl.h>
+#include <pthread.h>
+#include <sys/syscall.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -64,6 +71,50 @@ ssize_t write(int fd, const void* data, size_t size) {
         return done;
     }
     return real_write(fd, data, size);
+}
+
+static long long allowed_count(void) {
+    const char* after = getenv("DQJ_FAULT_AFTER");
+    return after ? atoll(after) : 0;
+}
+
+ssize_t read(int fd, void* data, size_t size) {
+    static ssize_t (*real_read)(int, void*, size_t);
+    static long long read_so_far;
+    if (!real_read) real_read = (ssize_t(*)(int, void*, size_t))dlsym(RTLD_NEXT, "read");
+    if (size > 0 && mode_is("read") && in_fault_dir(fd)) {
+        const long long allowed = allowed_count();
+        if (read_so_far >= allowed) {
+            errno = EIO;
+            return -1;
+        }
+        if ((long long)size > allowed - read_so_far) size = (size_t)(allowed - read_so_far);
+        const ssize_t done = real_read(fd, data, size);
+        if (done > 0) read_so_far += done;
+        return done;
+    }
+    return real_read(fd, data, size);
+}
+
+int pthread_create(pthread_t* thread, const pthread_attr_t* attributes, void* (*routine)(void*), void* argument) {
+    static int (*real_create)(pthread_t*, const pthread_attr_t*, void* (*)(void*), void*);
+    static long long made; /* read and written under no lock: the tests' counts are small */
+    if (!real_create)
+        real_create =
+            (int (*)(pthread_t*, const pthread_attr_t*, void* (*)(void*), void*))dlsym(RTLD_NEXT, "pthread_create");
+    if (mode_is("threads") && __atomic_fetch_add(&made, 1, __ATOMIC_SEQ_CST) >= allowed_count()) {
+        const char* log = getenv("DQJ_FAULT_LOG");
+        if (log && *log) {
+            /* the raw system calls: this library's own write must not count them */
+            const int fd = (int)syscall(SYS_openat, AT_FDCWD, log, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+            if (fd >= 0) {
+                syscall(SYS_write, fd, "refused\n", 8);
+                syscall(SYS_close, fd);
+            }
+        }
+        return EAGAIN;
+    }
+    return real_create(thread, attributes, routine, argument);
 }
 
 static int refuse_tmpfile(int flags) {

@@ -59,7 +59,7 @@ typedef enum dqj_status {
     DQJ_ERROR_PARAMETERS = 3,       /* parameter file or value rejected; the message names the key */
     DQJ_ERROR_IO = 4,               /* a file could not be read or written */
     DQJ_ERROR_CANCELLED = 5,        /* the progress callback asked to stop */
-    DQJ_ERROR_OUT_OF_MEMORY = 6,
+    DQJ_ERROR_OUT_OF_MEMORY = 6,    /* over the memory limit (refused before the work), or memory or a thread refused */
     DQJ_ERROR_INTERNAL = 7,
     DQJ_ERROR_BUSY = 8 /* a call on this context is running (e.g. from its progress callback) */
 } dqj_status;

@@ -61,8 +61,11 @@ struct MergeStats {
 /// Merges the tiles (any order) into `path`, written as bakeVdb() writes the one-piece bake.
 /// Throws ParamError (key "tiles") when the files are not tiles of one bake made by this
 /// version of dqjulia, or do not cover it once (saying which are missing or repeated);
-/// std::runtime_error when a file cannot be read or written; Cancelled.
+/// MemoryLimitError, before any grid is read, when the estimate (from the memory each tile's
+/// grids take, in its metadata) exceeds `memoryLimit` (0: defaultMemoryLimit()) or what the
+/// process may allocate; std::runtime_error when a file cannot be read or written; Cancelled.
 DQJ_API MergeStats mergeTiles(const std::vector<std::string>& tiles, const std::string& path,
-                              Existing existing = Existing::Replace, const ProgressCallback& progress = {});
+                              Existing existing = Existing::Replace, const ProgressCallback& progress = {},
+                              std::uint64_t memoryLimit = 0);
 
 }  // namespace dqj
