@@ -85,8 +85,14 @@ def link_inputs(map_path):
     objects and shared libraries loaded (paths normalised; relative ones are the build's)."""
     text = map_path.read_text(encoding="utf-8", errors="replace")
     members = text.split("Archive member included to satisfy reference by file (symbol)", 1)[-1]
-    members = members.split("\nMemory Configuration", 1)[0]
-    used = set(re.findall(r"^(\S[^\n(]*\.a)\(", members, re.M))
+    for end in (
+        "\nAs-needed library",
+        "\nAllocating common symbols",
+        "\nDiscarded input sections",
+        "\nMemory Configuration",
+    ):
+        members = members.split(end, 1)[0]
+    used = set(re.findall(r"^([^\s(][^\n(]*\.a)\(", members, re.M))
     for loaded in re.findall(r"^LOAD (.+)$", text, re.M):
         if not loaded.endswith(".a"):
             used.add(loaded.strip())
