@@ -1,6 +1,7 @@
 # Stages the add-on and zips it (run by the blender_addon target):
 #   dqjulia/            the Python package, shaders/ and blender_manifest.toml
 #   dqjulia/_buildinfo.py
+#   dqjulia/native.py   the ctypes bindings: NATIVE (python/dqjulia/_native.py), the Python package's, unchanged
 #   dqjulia/presets/    examples/*.json
 #   dqjulia/schema.json the parameter schema (dqjulia schema), which props.py builds the properties from
 #   dqjulia/lib/LIBRARY_NAME    the real library file (not a symlink), stripped: libdqjulia.so, or
@@ -14,6 +15,7 @@ file(MAKE_DIRECTORY "${STAGE}/dqjulia/lib" "${STAGE}/dqjulia/presets")
 file(COPY "${SOURCE}/" DESTINATION "${STAGE}/dqjulia"
      PATTERN "__pycache__" EXCLUDE PATTERN "*.pyc" EXCLUDE)
 file(COPY "${BUILDINFO}" DESTINATION "${STAGE}/dqjulia")
+file(COPY_FILE "${NATIVE}" "${STAGE}/dqjulia/native.py")
 # The project's version (VERSION) into the manifest (4.2+) and bl_info (3.4 - 4.1), which Blender
 # reads as literals without running the add-on. tests/version_test.py checks the zip's.
 string(REPLACE "." ", " version_tuple "${VERSION}")

@@ -101,8 +101,12 @@ apt_dir="$work/apt"
 mkdir -p "$apt_dir/parts" "$apt_dir/lists/partial" "$apt_dir/cache/archives/partial" "$work/src"
 sources=/etc/apt/sources.list.d/debian.sources
 [ -f "$sources" ] && sed 's/^Types:.*/Types: deb-src/' "$sources" > "$apt_dir/parts/debian.sources"
-if [ ! -s "$apt_dir/parts/debian.sources" ]; then
-  echo "dqjulia deps: no Debian apt sources found (/etc/apt/sources.list.d/debian.sources)" >&2
+# The one-line format, which Debian 12's installer and debootstrap write: its Debian lines.
+[ -f /etc/apt/sources.list ] &&
+  sed -nE 's#^[[:space:]]*deb[[:space:]]+((\[[^]]*\][[:space:]]+)?[^[:space:]]+/debian(-security)?/?[[:space:]].*)#deb-src \1#p' \
+    /etc/apt/sources.list > "$apt_dir/parts/debian.list"
+if [ ! -s "$apt_dir/parts/debian.sources" ] && [ ! -s "$apt_dir/parts/debian.list" ]; then
+  echo "dqjulia deps: no Debian apt sources found (/etc/apt/sources.list.d/debian.sources, /etc/apt/sources.list)" >&2
   exit 1
 fi
 apt_opts=(-o Dir::Etc::sourcelist=/dev/null -o "Dir::Etc::sourceparts=$apt_dir/parts"

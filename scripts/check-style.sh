@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Checks the code against the project's style: clang-format (.clang-format) on C and C++,
-# ruff (ruff.toml: lint and format) on the Python of blender_addon/, scripts/ and tests/, and
+# ruff (ruff.toml: lint and format) on the Python of blender_addon/, python/, scripts/ and tests/, and
 # clang-tidy (.clang-tidy) on C and C++ sources with build/compile_commands.json.
 #
 #   scripts/check-style.sh          the lines changed since the base: what a commit must keep clean
@@ -46,7 +46,7 @@ missing() {  # the project's rule for a missing tool (tests/script_support.cmake
 have() { command -v "$1" >/dev/null 2>&1; }
 
 is_cxx() { case "$1" in *.c | *.cpp | *.h | *.hpp) return 0 ;; esac; return 1; }
-is_python() { case "$1" in blender_addon/*.py | scripts/*.py | tests/*.py) return 0 ;; esac; return 1; }
+is_python() { case "$1" in blender_addon/*.py | python/*.py | scripts/*.py | tests/*.py) return 0 ;; esac; return 1; }
 
 # The files to check and, unless --all, the lines changed in each ("FIRST:LAST" ranges).
 declare -A ranges=()

@@ -2,8 +2,11 @@
 # A one-node Slurm cluster on this machine, for tests/farm and for trying `dqjulia farm slurm`
 # by hand: munged and Slurm 22.05's slurmctld and slurmd (Debian's slurm-wlm and munge, which
 # scripts/install-deps.sh installs), with no systemd, cgroups or accounting. Everything it
-# makes (its configuration, key, state, spool, logs, the munge socket) stays in one folder, so
-# it never touches a real cluster's files; the daemons are stopped by the PIDs it recorded.
+# makes stays in folders of its own, so it never touches a real cluster's files: Slurm's
+# configuration, state, spool and logs in DIR (Slurm runs as root), munged's key, socket and log in
+# a private folder under /run owned by the munge user (munged runs as munge, which may not reach
+# DIR: a checkout in a home of mode 0700, say), named in DIR/munge.dir, its log copied into DIR at
+# stop. The daemons are stopped by the PIDs it recorded.
 #
 #   scripts/slurm-local.sh start DIR   start the daemons (about a second), wait until the node is idle,
 #                                      print `export SLURM_CONF=DIR/slurm.conf` for the client commands
@@ -31,10 +34,22 @@ stop_pid_file() {  # stop_pid_file FILE: SIGTERM the PID it names, wait up to 10
   rm -f "$file"
 }
 
+remove_munge_dir() {  # the private folder of munged named in DIR/munge.dir (its log kept in DIR)
+  local munge_dir
+  munge_dir=$(cat "$dir/munge.dir" 2>/dev/null || true)
+  case "$munge_dir" in
+    /run/dqjulia-munge.*)
+      cp "$munge_dir/munged.log" "$dir/munged.log" 2>/dev/null || true
+      rm -rf "$munge_dir" ;;
+  esac
+  rm -f "$dir/munge.dir"
+}
+
 if [ "$action" = stop ]; then
   stop_pid_file "$dir/slurmd.pid"
   stop_pid_file "$dir/slurmctld.pid"
   stop_pid_file "$dir/munged.pid"
+  remove_munge_dir
   exit 0
 fi
 [ "$action" = start ] || usage
@@ -44,10 +59,12 @@ for tool in munged mungekey slurmctld slurmd sinfo; do
 done
 id munge >/dev/null 2>&1 || { echo "slurm-local.sh: there is no munge user (install the munge package)" >&2; exit 3; }
 
-mkdir -p "$dir"/{state,spool,munge}
-chmod 755 "$dir"
-chown munge: "$dir/munge"
-chmod 755 "$dir/munge"  # the socket must be reachable; the key itself is 0600
+mkdir -p "$dir"/{state,spool}
+remove_munge_dir  # one left by a start that was never stopped
+munge=$(mktemp -d /run/dqjulia-munge.XXXXXX)
+echo "$munge" > "$dir/munge.dir"
+chown munge: "$munge"
+chmod 755 "$munge"  # the socket must be reachable; the key itself is 0600
 host=$(hostname -s)
 free_port() { python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])'; }
 ctld_port=$(free_port)
@@ -55,11 +72,11 @@ slurmd_port=$(free_port)
 while [ "$slurmd_port" = "$ctld_port" ]; do slurmd_port=$(free_port); done
 memory=$(awk '/MemTotal/ {print int($2 / 1024 / 2)}' /proc/meminfo)
 
-# munged with its own key and socket in the folder, as the munge user.
-[ -s "$dir/munge/munge.key" ] || runuser -u munge -- mungekey --create --keyfile="$dir/munge/munge.key"
-runuser -u munge -- munged --socket="$dir/munge/munge.socket" --key-file="$dir/munge/munge.key" \
-  --pid-file="$dir/munge/munged.pid" --log-file="$dir/munge/munged.log" --seed-file="$dir/munge/munged.seed"
-cp "$dir/munge/munged.pid" "$dir/munged.pid"
+# munged with its own key and socket in its folder, as the munge user.
+runuser -u munge -- mungekey --create --keyfile="$munge/munge.key"
+runuser -u munge -- munged --socket="$munge/munge.socket" --key-file="$munge/munge.key" \
+  --pid-file="$munge/munged.pid" --log-file="$munge/munged.log" --seed-file="$munge/munged.seed"
+cp "$munge/munged.pid" "$dir/munged.pid"
 
 cat > "$dir/slurm.conf" <<EOF
 # Written by scripts/slurm-local.sh: a one-node cluster in $dir.
@@ -69,7 +86,7 @@ SlurmctldPort=$ctld_port
 SlurmdPort=$slurmd_port
 SlurmUser=root
 AuthType=auth/munge
-AuthInfo=socket=$dir/munge/munge.socket
+AuthInfo=socket=$munge/munge.socket
 CredType=cred/munge
 ProctrackType=proctrack/linuxproc
 TaskPlugin=task/none

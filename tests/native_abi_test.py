@@ -1,4 +1,5 @@
-"""The add-on's ctypes bindings (blender_addon/dqjulia/native.py) against the C header
+"""The ctypes bindings (python/dqjulia/_native.py: the Python package's, and the add-on's native.py,
+a copy) against the C header
 (core/include/dqjulia/dqjulia.h): every status code, feature name and function with its
 argument count, the fields of every struct, and the progress callback's convention, so the
 bindings can never drift from the ABI they describe. Given the C test program, also each
@@ -32,7 +33,7 @@ def main():
     with open(source + "/core/include/dqjulia/dqjulia.h") as file:
         header = file.read()
     header = re.sub(r"/\*.*?\*/", "", header, flags=re.S)
-    spec = importlib.util.spec_from_file_location("native", source + "/blender_addon/dqjulia/native.py")
+    spec = importlib.util.spec_from_file_location("native", source + "/python/dqjulia/_native.py")
     native = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(native)
     checks = {}

@@ -1,7 +1,8 @@
 """dqjulia for Blender: dual-quaternion Julia fractals as a live viewport preview, baked
 OpenVDB volumes and meshes, and an OSL volume, all computed by the dqjulia core library.
 
-Layout (one idea a module): native.py (ctypes bindings of the C ABI), props.py (the
+Layout (one idea a module): native.py (ctypes bindings of the C ABI: the Python package's
+python/dqjulia/_native.py, which the build copies into the zip), props.py (the
 parameters on the object and the parameter file's JSON), slicing.py (the slice's 8-D axes),
 animation.py (keyframes), preview.py (the GLSL preview), jobs.py (work in a thread),
 bakes.py (cache folder, objects from bakes), operators.py, farm.py (farm tasks' bakes), panels.py,

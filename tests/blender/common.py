@@ -15,7 +15,7 @@ import bpy
 
 
 def bpy_wheel_python_modules():
-    """The bpy wheels 4.5 and 5.0 ship Blender's own Python modules (oslquery, OpenImageIO, ...)
+    """The bpy wheels 4.5 and later ship Blender's own Python modules (oslquery, OpenImageIO, ...)
     in bpy/<version>/python/lib/python3.X/site-packages, which is not on sys.path of the venv's
     Python; Cycles imports oslquery to compile an OSL Script node (4.5+). Blender the program has
     that folder on its path: put it on ours too, so a Script node compiles as it does there."""

@@ -6,7 +6,9 @@ the same bakes made here in one piece.
       brings up a one-node Slurm cluster on localhost (scripts/slurm-local.sh), submits a frame
       array (4 frames, 2 a task) and a tiled bake (2x2x1) with its dependent merge job, waits
       for the queue to empty (polling squeue: sbatch --wait can lag), compares every output
-      with a local bake, and stops the daemons by their PIDs whatever happened.
+      with a local bake, and stops the daemons by their PIDs whatever happened. The cluster's
+      folder is inside one of mode 0700 (as a checkout in /root is), which munged's user
+      cannot enter.
   farm_test.py openjd --cli DQJULIA --work DIR --openjd OPENJD
       writes a template (3 frames in chunks of 2, 2 tiles each, a Merge step), has
       `openjd check` accept it and `openjd run` run it locally, and compares the merged frames.
@@ -82,7 +84,12 @@ def test_slurm(args):
     if os.geteuid() != 0:
         skip_or_fail("the local Slurm cluster needs root (munged runs as the munge user)")
     params = prepare(args.work)
-    cluster = os.path.join(args.work, "cluster")
+    # The cluster's folder inside one of mode 0700, as a checkout in root's home on Debian is:
+    # munged (the munge user) must keep its files where it can reach them all the same.
+    private = os.path.join(args.work, "private")
+    os.makedirs(private, mode=0o700)
+    os.chmod(private, 0o700)
+    cluster = os.path.join(private, "cluster")
     local = os.path.join(args.work, "local")
     os.makedirs(local)
     frames, tiles = os.path.join(args.work, "frames", "anim.vdb"), os.path.join(args.work, "tiles", "big.vdb")

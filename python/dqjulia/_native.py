@@ -1,36 +1,59 @@
 """ctypes bindings of libdqjulia's C ABI (core/include/dqjulia/dqjulia.h).
 
-The one module that talks to the native library. It is loaded lazily, on first use, so the
-add-on registers (and its panels can explain the problem) even when the library is missing
-or of the wrong version; `load_error()` gives that explanation in words a user can act on.
+The one set of Python bindings of the library, written once: it is the Python package's
+dqjulia/_native.py, under the public API of dqjulia/__init__.py, and the Blender add-on's
+dqjulia/native.py, which the add-on's packaging copies from here unchanged (tests/python check
+that both copies are this file). Where the two differ (what to reinstall, the version expected)
+comes from the _buildinfo.py the build writes beside each copy.
 
-Every function is declared with its argtypes and restype. Functions the add-on can live
-without (baking, keyframes) belong to optional features, which the library is asked for
+The library is loaded lazily, on first use, so the add-on registers (and its panels can explain
+the problem) and the package imports even when the library is missing or of the wrong version;
+`load_error()` gives that explanation in words a user can act on. On Linux the C library is
+checked first (glibc 2.34 or newer, `platform_problem()`), so an older system is told so instead
+of meeting a loader error.
+
+Every function is declared with its argtypes and restype. Functions a host can live without
+(baking, keyframes) belong to optional features, which the library is asked for
 (dqj_has_feature), never probed for symbols: `has_feature(name)` and `has(function)` say
 whether the loaded library has them, and calling a missing one raises NativeUnavailable with
 the reason.
 
-No bpy here: the module is used from worker threads (ctypes releases the GIL during each
-call) and by the tests outside Blender.
+Errors are one hierarchy: DqjuliaError, with LibraryUnavailableError (the library cannot be
+used) and StatusError (a call returned a dqj_status other than DQJ_OK), whose subclasses follow
+the status codes (ERROR_CLASSES). NativeError and NativeUnavailable are the add-on's names of
+StatusError and LibraryUnavailableError.
+
+No bpy and no NumPy here: the module is used from Blender's worker threads (ctypes releases the
+GIL during each call), by the package and by the tests. Buffers are passed as ctypes objects or
+pointers (the *_into methods), so callers can hand in NumPy arrays without a copy.
 """
 
 import ctypes
 import json
 import os
+import re
 import sys
 import threading
 
 try:
     from . import _buildinfo
-except ImportError:  # running from the source tree, not from the built zip
-    _buildinfo = None
+except ImportError:  # running from the source tree, not from a built add-on zip or wheel
+    _buildinfo = None  # type: ignore[assignment]
 
-# The C ABI version this add-on was built against (DQJ_VERSION_NUMBER = major*10000 +
+# The C ABI version this copy was built against (DQJ_VERSION_NUMBER = major*10000 +
 # minor*100 + patch, from dqjulia.h at build time). A library loads if its major version is
 # the same and it is not older: minor versions only add functions.
 EXPECTED_VERSION = getattr(_buildinfo, "DQJ_VERSION_NUMBER", 100)
+# What holds this copy ("the add-on", "the Python package dqjulia") and how a user gets the
+# library back, for the messages below.
+HOST = getattr(_buildinfo, "HOST", "dqjulia")
+REINSTALL = getattr(_buildinfo, "REINSTALL", "reinstall dqjulia")
 
 LIBRARY_ENV = "DQJULIA_LIBRARY"  # developers: load this file instead of the bundled one
+
+# The oldest glibc the Linux library and command run on (their newest GLIBC_ symbol version,
+# checked by tests/cleanroom/check_library.py).
+GLIBC_FLOOR = (2, 34)
 
 # dqj_status
 OK = 0
@@ -45,19 +68,26 @@ ERROR_BUSY = 8  # a call on the context is running (e.g. destroy from its own pr
 
 VARIANTS = ("paper", "paper-coupled", "dual")  # dqj_variant order
 
-# The optional features this add-on knows (DQJ_FEATURE_*), for dqj_has_feature.
+# The optional features this copy knows (DQJ_FEATURE_*), for dqj_has_feature.
 FEATURE_VDB = "vdb"
 FEATURE_MESH = "mesh"
 FEATURE_ANIMATION = "animation"
 FEATURES = (FEATURE_VDB, FEATURE_MESH, FEATURE_ANIMATION)
 
 
-class NativeUnavailable(RuntimeError):
-    """The library could not be loaded (missing, wrong version, or lacks a function)."""
+class DqjuliaError(RuntimeError):
+    """Every error of dqjulia's library: it cannot be used (LibraryUnavailableError), or a call
+    failed (StatusError and its subclasses, one a dqj_status)."""
 
 
-class NativeError(RuntimeError):
-    """A call returned a status other than DQJ_OK; `status` and the context's message."""
+class LibraryUnavailableError(DqjuliaError):
+    """The library cannot be used: missing, of another version, built for another system, or
+    lacking a function; the message says which and what to do."""
+
+
+class StatusError(DqjuliaError):
+    """A call returned a dqj_status other than DQJ_OK: `status` (the code), `message` (the
+    library's own text, naming the key or file at fault)."""
 
     def __init__(self, status, message):
         self.status = status
@@ -67,6 +97,63 @@ class NativeError(RuntimeError):
     @property
     def cancelled(self):
         return self.status == ERROR_CANCELLED
+
+
+class InvalidHandleError(StatusError):
+    """DQJ_ERROR_INVALID_HANDLE: the context was closed (or never made)."""
+
+
+class InvalidArgumentError(StatusError, ValueError):
+    """DQJ_ERROR_INVALID_ARGUMENT: a value out of range, a buffer too small."""
+
+
+class ParameterError(StatusError, ValueError):
+    """DQJ_ERROR_PARAMETERS: the parameter document or a value was rejected; the message names
+    the key, what was wrong and what is allowed."""
+
+
+class FileError(StatusError, OSError):
+    """DQJ_ERROR_IO: a file could not be read or written (nothing partial is left)."""
+
+
+class CancelledError(StatusError):
+    """DQJ_ERROR_CANCELLED: the work was cancelled (its progress callback asked to stop)."""
+
+
+class OutOfMemoryError(StatusError, MemoryError):
+    """DQJ_ERROR_OUT_OF_MEMORY: the work would need more memory than allowed (refused before it
+    starts, with the estimate) or memory ran out."""
+
+
+class InternalError(StatusError):
+    """DQJ_ERROR_INTERNAL: a fault inside the library (please report it)."""
+
+
+class BusyError(StatusError):
+    """DQJ_ERROR_BUSY: another call on the same context is running; one call at a time."""
+
+
+# dqj_status -> the class raised for it.
+ERROR_CLASSES = {
+    ERROR_INVALID_HANDLE: InvalidHandleError,
+    ERROR_INVALID_ARGUMENT: InvalidArgumentError,
+    ERROR_PARAMETERS: ParameterError,
+    ERROR_IO: FileError,
+    ERROR_CANCELLED: CancelledError,
+    ERROR_OUT_OF_MEMORY: OutOfMemoryError,
+    ERROR_INTERNAL: InternalError,
+    ERROR_BUSY: BusyError,
+}
+
+
+def error_for(status, message):
+    """The exception for a status: its class of ERROR_CLASSES (StatusError for an unknown one)."""
+    return ERROR_CLASSES.get(status, StatusError)(status, message)
+
+
+# The add-on's names.
+NativeError = StatusError
+NativeUnavailable = LibraryUnavailableError
 
 
 class Sample(ctypes.Structure):
@@ -185,25 +272,66 @@ _library = None
 _load_error = None
 _library_path = None
 _dll_directory = None  # Windows: the library's folder, added to the DLL search path while loaded
-_features = frozenset()  # the FEATURES the loaded library has
-_bound = frozenset()  # the functions of _SIGNATURES it offers
+_features: "frozenset[str]" = frozenset()  # the FEATURES the loaded library has
+_bound: "frozenset[str]" = frozenset()  # the functions of _SIGNATURES it offers
 
 
 def version_text(number):
     return "%d.%d.%d" % (number // 10000, number // 100 % 100, number % 100)
 
 
+_GLIBC_TEXT = "glibc %d.%d" % GLIBC_FLOOR
 # What the library needs of the system it runs on, by sys.platform (for the message when it does not load).
 _REQUIREMENTS = {
     "win32": "64-bit Windows (x64) with its own system libraries",
-    "linux": "Linux x86-64 with glibc 2.34 or newer (Debian 12, Ubuntu 22.04, RHEL 9 or later)",
+    "linux": "Linux x86-64 with %s or newer (Debian 12, Ubuntu 22.04, RHEL 9, Fedora 35 or later)" % _GLIBC_TEXT,
 }
 
 
+def platform_problem():
+    """None when this system can run dqjulia's native code as far as can be told without loading
+    it, else why not in plain words. On Linux: the C library must be glibc at GLIBC_FLOOR or newer
+    (asked with os.confstr, so nothing is loaded that would fail with a loader error)."""
+    if not sys.platform.startswith("linux"):
+        return None
+    try:
+        found = os.confstr("CS_GNU_LIBC_VERSION") or ""  # "glibc 2.36"
+    except (AttributeError, ValueError, OSError):
+        found = ""
+    match = re.match(r"glibc (\d+)\.(\d+)", found)
+    needs = "dqjulia's native code needs %s" % _REQUIREMENTS["linux"]
+    if match is None:
+        return "%s; this system's C library is not glibc (%s)" % (needs, found or "unknown")
+    version = (int(match.group(1)), int(match.group(2)))
+    if version < GLIBC_FLOOR:
+        found = "glibc %d.%d" % version
+        return "%s; this system has %s, older than %s. Use a newer system, or build dqjulia from source on it" % (
+            needs,
+            found,
+            _GLIBC_TEXT,
+        )
+    return None
+
+
+def bundled_file(folder, tree_folder, name):
+    """A native file shipped with this code: FOLDER/NAME beside this file, where the add-on zip and
+    the wheel put it. The package's modules alone in an install tree, as
+    <prefix>/lib/python/dqjulia, use the tree's own file instead: <prefix>/TREE_FOLDER/NAME."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    beside = os.path.join(here, folder, name)
+    python_folder = os.path.dirname(here)
+    if os.path.isfile(beside) or os.path.basename(python_folder) != "python":
+        return beside
+    in_tree = os.path.join(os.path.dirname(os.path.dirname(python_folder)), tree_folder, name)
+    return in_tree if os.path.isfile(in_tree) else beside
+
+
 def bundled_library_path():
-    """Where the zip puts the library: lib/ beside this file (the zip made for this platform)."""
-    names = {"win32": "dqjulia.dll", "darwin": "libdqjulia.dylib"}
-    return os.path.join(os.path.dirname(os.path.abspath(__file__)), "lib", names.get(sys.platform, "libdqjulia.so"))
+    """Where the library is: lib/ beside this file (the one made for this platform), or an install
+    tree's lib/libdqjulia.so or bin/dqjulia.dll (bundled_file)."""
+    if sys.platform == "win32":
+        return bundled_file("lib", "bin", "dqjulia.dll")
+    return bundled_file("lib", "lib", {"darwin": "libdqjulia.dylib"}.get(sys.platform, "libdqjulia.so"))
 
 
 def library_path():
@@ -218,9 +346,9 @@ def _bind(library):
         try:
             function = getattr(library, name)
         except AttributeError:
-            raise NativeUnavailable(
-                "the dqjulia library at %s has no function %s: it is not the library this add-on was "
-                "built with; reinstall the add-on zip" % (_library_path, name)
+            raise LibraryUnavailableError(
+                "the dqjulia library at %s has no function %s: it is not the library %s was built with; %s"
+                % (_library_path, name, HOST, REINSTALL)
             ) from None
         function.restype = restype
         function.argtypes = argtypes
@@ -240,48 +368,50 @@ def _load():
     global _library_path, _dll_directory
     path = library_path()
     _library_path = path
+    problem = platform_problem()
+    if problem is not None:
+        raise LibraryUnavailableError(problem)
     if not os.path.isfile(path):
-        raise NativeUnavailable(
-            "the dqjulia native library is missing: expected %s. The add-on zip must be the one the build "
-            "makes (build/dist/dqjulia_blender.zip), which holds the library; reinstall it" % path
+        raise LibraryUnavailableError(
+            "the dqjulia native library is missing: expected %s, which %s holds; %s" % (path, HOST, REINSTALL)
         )
     try:
         if hasattr(os, "add_dll_directory") and _dll_directory is None:  # Windows: DLLs beside it are found
             _dll_directory = os.add_dll_directory(os.path.dirname(os.path.abspath(path)))
         library = ctypes.CDLL(path)
     except OSError as error:
-        raise NativeUnavailable(
+        raise LibraryUnavailableError(
             "the dqjulia native library at %s could not be loaded (%s). It is self-contained and needs only "
-            "%s; on another system, build the add-on there (README, Two commands)"
+            "%s; on another system, build dqjulia there (README, Two commands)"
             % (path, error, _REQUIREMENTS.get(sys.platform, _REQUIREMENTS["linux"]))
         ) from error
     try:
         version_number = library.dqj_version_number
     except AttributeError:
-        raise NativeUnavailable("%s is not the dqjulia library (no dqj_version_number)" % path) from None
+        raise LibraryUnavailableError("%s is not the dqjulia library (no dqj_version_number)" % path) from None
     version_number.restype = ctypes.c_uint
     version_number.argtypes = []
     found = version_number()
     if found // 10000 != EXPECTED_VERSION // 10000 or found < EXPECTED_VERSION:
-        raise NativeUnavailable(
-            "the dqjulia library at %s is version %s, but this add-on needs %s (same major version, not "
-            "older): install the add-on zip and the library from the same build"
-            % (path, version_text(found), version_text(EXPECTED_VERSION))
+        raise LibraryUnavailableError(
+            "the dqjulia library at %s is version %s, but %s needs %s (same major version, not older): "
+            "%s, so that it and its library come from the same build"
+            % (path, version_text(found), HOST, version_text(EXPECTED_VERSION), REINSTALL)
         )
     return library, _bind(library)
 
 
 def library():
-    """The loaded library; raises NativeUnavailable (with the reason) if it cannot be used."""
+    """The loaded library; raises LibraryUnavailableError (with the reason) if it cannot be used."""
     global _library, _load_error, _features, _bound
     with _lock:
         if _library is None and _load_error is None:
             try:
                 _library, (_features, _bound) = _load()
-            except NativeUnavailable as error:
+            except LibraryUnavailableError as error:
                 _load_error = str(error)
         if _library is None:
-            raise NativeUnavailable(_load_error)
+            raise LibraryUnavailableError(_load_error)
         return _library
 
 
@@ -290,7 +420,7 @@ def load_error():
     try:
         library()
         return None
-    except NativeUnavailable as error:
+    except LibraryUnavailableError as error:
         return str(error)
 
 
@@ -306,10 +436,10 @@ def reset():
 
 def has_feature(name):
     """Whether the loaded library has this optional feature (FEATURE_*; False if it cannot be
-    loaded or the add-on does not know the name)."""
+    loaded or this copy does not know the name)."""
     try:
         library()
-    except NativeUnavailable:
+    except LibraryUnavailableError:
         return False
     return name in _features
 
@@ -319,7 +449,7 @@ def has(name):
     loaded)."""
     try:
         library()
-    except NativeUnavailable:
+    except LibraryUnavailableError:
         return False
     return name in _bound
 
@@ -337,9 +467,9 @@ def status_text(status):
 def _function(name):
     lib = library()
     if name not in _bound:
-        raise NativeUnavailable(
-            "the dqjulia library %s has no %s (it lacks the feature %s); this add-on needs a library that has it"
-            % (version()[1], name, " or ".join(_SIGNATURES[name][2] or ()) if name in _SIGNATURES else "?")
+        raise LibraryUnavailableError(
+            "the dqjulia library %s has no %s (it lacks the feature %s); %s needs a library that has it"
+            % (version()[1], name, " or ".join(_SIGNATURES[name][2] or ()) if name in _SIGNATURES else "?", HOST)
         )
     return getattr(lib, name)
 
@@ -350,12 +480,19 @@ class Progress:
     `callback` is the ctypes function pointer to pass; keep this object alive during the call
     (ctypes does not). `cancel()` may be called from any thread; the native call then returns
     DQJ_ERROR_CANCELLED at its next progress report (a few times a second).
+
+    An exception never unwinds into C. One raised by `on_progress` cancels the work when
+    `cancel_on_error` is set, and always when it is not an Exception (a KeyboardInterrupt from
+    Ctrl-C, delivered while the callback runs Python code): it is kept in `error` and raised by
+    `raise_error()` once the native call has returned. Otherwise it is ignored and the work goes on.
     """
 
-    def __init__(self, on_progress=None):
+    def __init__(self, on_progress=None, cancel_on_error=False):
         self.fraction = 0.0
+        self.error = None
         self._cancel = threading.Event()
         self._on_progress = on_progress
+        self._cancel_on_error = cancel_on_error
         self.callback = PROGRESS_FN(self._report)
 
     def _report(self, fraction, _user):
@@ -363,8 +500,10 @@ class Progress:
             self.fraction = max(0.0, min(1.0, float(fraction)))
             if self._on_progress is not None:
                 self._on_progress(self.fraction)
-        except Exception:  # an exception must never unwind into C
-            pass
+        except BaseException as error:  # an exception must never unwind into C
+            if self._cancel_on_error or not isinstance(error, Exception):
+                self.error = self.error or error
+                self._cancel.set()
         return 0 if self._cancel.is_set() else 1  # dqj_progress_fn: non-zero goes on, 0 cancels
 
     def cancel(self):
@@ -373,6 +512,12 @@ class Progress:
     @property
     def cancelled(self):
         return self._cancel.is_set()
+
+    def raise_error(self):
+        """Raises the exception the callback kept, if any (after the native call returned)."""
+        if self.error is not None:
+            error, self.error = self.error, None
+            raise error
 
 
 def _text(pointer):
@@ -387,18 +532,18 @@ class Context:
         handle = _handle()
         status = self._lib.dqj_context_create(ctypes.byref(handle))
         if status != OK:
-            raise NativeError(status, "dqj_context_create failed: %s" % status_text(status))
+            raise error_for(status, "dqj_context_create failed: %s" % status_text(status))
         self._handle = handle
         if params is not None:
             self.set_params(params)
 
     def close(self):
-        """Destroys the native context. Raises NativeError (ERROR_BUSY) if one of its calls is
-        still running, e.g. when called from that call's progress callback: cancel instead."""
+        """Destroys the native context. Raises BusyError if one of its calls is still running,
+        e.g. when called from that call's progress callback: cancel instead."""
         if getattr(self, "_handle", None):
             status = self._lib.dqj_context_destroy(self._handle)
             if status == ERROR_BUSY:
-                raise NativeError(status, "the dqjulia context is busy (a call on it is running): cancel it first")
+                raise BusyError(status, "the dqjulia context is busy (a call on it is running): cancel it first")
             self._handle = None
 
     def __del__(self):
@@ -416,7 +561,7 @@ class Context:
     @property
     def handle(self):
         if not self._handle:
-            raise NativeError(ERROR_INVALID_HANDLE, "the dqjulia context was closed")
+            raise InvalidHandleError(ERROR_INVALID_HANDLE, "the dqjulia context was closed")
         return self._handle
 
     def error(self):
@@ -428,7 +573,7 @@ class Context:
     def check(self, status, what):
         if status != OK:
             message = self.error() or status_text(status)
-            raise NativeError(status, "%s: %s" % (what, message) if what else message)
+            raise error_for(status, "%s: %s" % (what, message) if what else message)
 
     def _text_out(self, function_name):
         function = _function(function_name)
@@ -437,6 +582,16 @@ class Context:
         buffer = ctypes.create_string_buffer(size.value)
         self.check(function(self.handle, buffer, size.value, ctypes.byref(size)), function_name)
         return buffer.value.decode("utf-8")
+
+    def _run(self, what, function, progress, *arguments):
+        """A call that reports progress: `function(handle, *arguments, callback, None)`. An error
+        kept by the callback (an exception in on_progress, Ctrl-C) is raised in place of the
+        cancel it caused."""
+        progress = progress or Progress()
+        status = function(self.handle, *arguments, progress.callback, None)
+        progress.raise_error()
+        self.check(status, what)
+        return self.warning()
 
     # Parameters -------------------------------------------------------------------------
 
@@ -459,7 +614,8 @@ class Context:
 
     def schema(self):
         """The parameter schema (dqj_params_schema_json) as a dict: every key's type, label, help,
-        default and range. props.py builds the properties from the packaged copy (schema.json)."""
+        default and range. The add-on's props.py builds its properties from the packaged copy
+        (schema.json)."""
         return json.loads(self._text_out("dqj_params_schema_json"))
 
     def inspect(self):
@@ -470,13 +626,13 @@ class Context:
 
     def evaluate_points(self, points):
         """points: sequence of 8-number sequences. Returns a list of Sample."""
-        return self._evaluate("dqj_evaluate_points", points, 8)
+        return self._evaluate(points, 8)
 
     def evaluate_slice_points(self, points):
         """points: sequence of (x, y, z) in the slice. Returns a list of Sample."""
-        return self._evaluate("dqj_evaluate_slice_points", points, 3)
+        return self._evaluate(points, 3)
 
-    def _evaluate(self, name, points, width):
+    def _evaluate(self, points, width):
         points = list(points)
         flat = (ctypes.c_double * (width * len(points)))()
         for index, point in enumerate(points):
@@ -484,8 +640,15 @@ class Context:
                 raise ValueError("each point needs %d numbers" % width)
             flat[width * index : width * index + width] = [float(x) for x in point]
         out = (Sample * max(1, len(points)))()
-        self.check(getattr(self._lib, name)(self.handle, flat, len(points), out), name)
+        self.evaluate_into(flat, len(points), out, slice_points=width == 3)
         return list(out[: len(points)])
+
+    def evaluate_into(self, points, count, out, slice_points=False):
+        """Evaluates `count` points from a buffer of doubles (8 a point, or 3 with slice_points)
+        into a buffer of `count` Sample: ctypes arrays or pointers (a NumPy array's
+        `ctypes.data_as(...)`), sized by the caller."""
+        name = "dqj_evaluate_slice_points" if slice_points else "dqj_evaluate_points"
+        self.check(getattr(self._lib, name)(self.handle, points, count, out), name)
 
     # Rendering --------------------------------------------------------------------------
 
@@ -493,15 +656,16 @@ class Context:
         """Renders with the core's renderer; returns (bytes RGBA8 sRGB rows top-down, warning)."""
         stride = 4 * width
         pixels = (ctypes.c_uint8 * (stride * height))()
-        progress = progress or Progress()
-        status = self._lib.dqj_render_rgba8(self.handle, pixels, width, height, stride, progress.callback, None)
-        self.check(status, "render")
-        return bytes(pixels), self.warning()
+        warning = self.render_rgba8_into(pixels, width, height, stride, progress)
+        return bytes(pixels), warning
+
+    def render_rgba8_into(self, pixels, width, height, stride, progress=None):
+        """Renders into a caller's buffer of `height` rows of `stride` bytes (a ctypes array or
+        pointer); returns the warning ("" if none)."""
+        return self._run("render", self._lib.dqj_render_rgba8, progress, pixels, width, height, stride)
 
     def render_to_file(self, path, progress=None):
-        progress = progress or Progress()
-        self.check(self._lib.dqj_render_to_file(self.handle, os.fsencode(path), progress.callback, None), "render")
-        return self.warning()
+        return self._run("render", self._lib.dqj_render_to_file, progress, os.fsencode(path))
 
     # Baking -----------------------------------------------------------------------------
 
@@ -517,15 +681,10 @@ class Context:
     def bake_vdb(self, path, progress=None):
         """Writes an OpenVDB file (grids "surface", "density" and bake.grids); all or nothing.
         Returns the context's warning ("" if none)."""
-        progress = progress or Progress()
-        function = _function("dqj_bake_vdb")
-        self.check(function(self.handle, os.fsencode(path), progress.callback, None), "bake")
-        return self.warning()
+        return self._run("bake", _function("dqj_bake_vdb"), progress, os.fsencode(path))
 
     def mesh_compute(self, progress=None):
-        progress = progress or Progress()
-        self.check(_function("dqj_mesh_compute")(self.handle, progress.callback, None), "mesh")
-        return self.warning()
+        return self._run("mesh", _function("dqj_mesh_compute"), progress)
 
     def mesh_sizes(self):
         vertices, triangles = ctypes.c_size_t(0), ctypes.c_size_t(0)
@@ -534,6 +693,29 @@ class Context:
         )
         return vertices.value, triangles.value
 
+    def mesh_face_counts(self):
+        """(quads, triangles) of the context's mesh as the core made it."""
+        quads, triangles = ctypes.c_size_t(0), ctypes.c_size_t(0)
+        self.check(
+            _function("dqj_mesh_get_face_counts")(self.handle, ctypes.byref(quads), ctypes.byref(triangles)),
+            "mesh face counts",
+        )
+        return quads.value, triangles.value
+
+    def mesh_copy_into(self, positions, normals, colors, vertex_capacity, triangles=None, triangle_capacity=0):
+        """dqj_mesh_copy into caller buffers (ctypes arrays or pointers; normals, colors and
+        triangles may be None)."""
+        function = _function("dqj_mesh_copy")
+        self.check(
+            function(self.handle, positions, normals, colors, vertex_capacity, triangles, triangle_capacity),
+            "mesh copy",
+        )
+
+    def mesh_copy_faces_into(self, quads, quad_capacity, triangles, triangle_capacity):
+        """dqj_mesh_copy_faces into caller buffers of 4 and 3 uint32 a face."""
+        function = _function("dqj_mesh_copy_faces")
+        self.check(function(self.handle, quads, quad_capacity, triangles, triangle_capacity), "mesh faces")
+
     def mesh_faces(self, colors=True):
         """The context's mesh with its faces as the core made them: (positions, normals, colors or
         None, quads, triangles) as ctypes arrays; 4 and 3 uint32 indices a face."""
@@ -541,20 +723,11 @@ class Context:
         positions = (ctypes.c_float * (3 * vertex_count))()
         normals = (ctypes.c_float * (3 * vertex_count))()
         colours = (ctypes.c_float * (3 * vertex_count))() if colors else None
-        self.check(
-            _function("dqj_mesh_copy")(self.handle, positions, normals, colours, vertex_count, None, 0), "mesh copy"
-        )
-        quad_count, triangle_count = ctypes.c_size_t(0), ctypes.c_size_t(0)
-        self.check(
-            _function("dqj_mesh_get_face_counts")(self.handle, ctypes.byref(quad_count), ctypes.byref(triangle_count)),
-            "mesh face counts",
-        )
-        quads = (ctypes.c_uint32 * (4 * quad_count.value))()
-        triangles = (ctypes.c_uint32 * (3 * triangle_count.value))()
-        self.check(
-            _function("dqj_mesh_copy_faces")(self.handle, quads, quad_count.value, triangles, triangle_count.value),
-            "mesh faces",
-        )
+        self.mesh_copy_into(positions, normals, colours, vertex_count)
+        quad_count, triangle_count = self.mesh_face_counts()
+        quads = (ctypes.c_uint32 * (4 * quad_count))()
+        triangles = (ctypes.c_uint32 * (3 * triangle_count))()
+        self.mesh_copy_faces_into(quads, quad_count, triangles, triangle_count)
         return positions, normals, colours, quads, triangles
 
     def mesh_write(self, path):

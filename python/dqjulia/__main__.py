@@ -1,0 +1,7 @@
+"""`python -m dqjulia ...`: the same as the `dqjulia` command."""
+
+import sys
+
+from ._cli import main
+
+sys.exit(main())
