@@ -3,10 +3,12 @@
 half of scripts/release.sh, which makes the two builds first; tests/release runs it on the test
 command's own build/ and build-windows/):
 
-  dqjulia-VERSION-linux-x64.tar.gz        the install trees (`cmake --install --strip`): bin/ lib/
-  dqjulia-VERSION-windows-x64.zip         (with the CMake package and dqjulia.pc) include/
-                                          share/dqjulia/ (POV-Ray include, examples) share/doc/dqjulia/
-                                          (README, CHANGELOG, LICENSE, notices, component list)
+  dqjulia-VERSION-linux-x64.tar.gz        the install trees (`cmake --install --strip`): bin/ (on
+  dqjulia-VERSION-windows-x64.zip         Linux the glibc-floor launcher, the command itself in
+                                          libexec/dqjulia/) lib/ (with the CMake package and
+                                          dqjulia.pc) include/ share/dqjulia/ (POV-Ray include,
+                                          examples) share/doc/dqjulia/ (README, CHANGELOG, LICENSE,
+                                          notices, component list)
   dqjulia_blender-VERSION-linux-x64.zip   the builds' Blender extension zips under their final names
   dqjulia_blender-VERSION-windows-x64.zip
   index.json                              the extension repository (scripts/extension-repo.py)
@@ -14,7 +16,8 @@ command's own build/ and build-windows/):
   THIRD-PARTY.json                        the component list of both targets
   SHA256SUMS                              of every other file, as sha256sum writes it
 
-Everything is reproducible: archives by scripts/pack.py, with SOURCE_DATE_EPOCH (by default the
+The version is VERSION's, checked against each build's. Everything is reproducible: the archives
+by scripts/pack.py, the wheels by scripts/build-wheels.py, with SOURCE_DATE_EPOCH (by default the
 commit's time) as every entry's time.
 
 Usage: dist.py --linux-build DIR --windows-build DIR --out DIR [--no-wheels] [--no-index]
@@ -30,10 +33,12 @@ import subprocess
 import sys
 from pathlib import Path
 
-SOURCE = Path(__file__).resolve().parent.parent
+from build_tree import SOURCE, BuildTreeError, cache_value, check_build
+from pack import PackError, folder_members, source_date_epoch, write_tar_gz, write_zip
+
 PLATFORMS = {
-    "linux-x64": {"archive": "tar.gz", "addon_zip": "dist/dqjulia_blender.zip"},
-    "windows-x64": {"archive": "zip", "addon_zip": "dist/dqjulia_blender-windows-x64.zip"},
+    "linux-x64": {"system": "Linux", "archive": "tar.gz", "addon_zip": "dist/dqjulia_blender.zip"},
+    "windows-x64": {"system": "Windows", "archive": "zip", "addon_zip": "dist/dqjulia_blender-windows-x64.zip"},
 }
 
 
@@ -55,35 +60,18 @@ def run(*command, **options):
     return result.stdout
 
 
-def cache_value(build, name):
-    """A variable of the build tree's CMakeCache.txt."""
-    cache = build / "CMakeCache.txt"
-    if not cache.is_file():
-        raise DistError("%s is not a configured build tree (no CMakeCache.txt)" % build)
-    for line in cache.read_text(encoding="utf-8", errors="replace").splitlines():
-        key, _, value = line.partition("=")
-        if key.split(":")[0] == name:
-            return value
-    return None
-
-
-def check_build(build, platform, version):
-    """The build tree is of this checkout, of this version and for this platform, and built."""
-    home = cache_value(build, "CMAKE_HOME_DIRECTORY")
-    if home is None or Path(home).resolve() != SOURCE:
-        raise DistError("%s is a build of %s, not of this checkout (%s)" % (build, home, SOURCE))
+def check_release_build(build, platform, version):
+    """The build tree is of this checkout, for this platform, of this version, and built."""
+    check_build(build, PLATFORMS[platform]["system"])
     built_version = cache_value(build, "CMAKE_PROJECT_VERSION")
     if built_version != version:
         raise DistError(
             "%s is a build of version %s, the checkout's VERSION is %s: build it again"
             % (build, built_version, version)
         )
-    windows = cache_value(build, "CMAKE_SYSTEM_NAME") == "Windows"
-    if windows != (platform == "windows-x64"):
-        raise DistError("%s is not a %s build" % (build, platform))
-    zip_path = build / PLATFORMS[platform]["addon_zip"]
-    if not zip_path.is_file():
-        raise DistError("%s is missing: build %s first" % (zip_path, build))
+    for needed in (PLATFORMS[platform]["addon_zip"], "licenses/THIRD-PARTY.json"):
+        if not (build / needed).is_file():
+            raise DistError("%s is missing: build %s first" % (build / needed, build))
 
 
 def install_tree(build, stage, name):
@@ -91,10 +79,6 @@ def install_tree(build, stage, name):
     tree = stage / name
     run("cmake", "--install", build, "--prefix", tree, "--strip")
     return tree
-
-
-def pack(kind, output, folder):
-    run(sys.executable, SOURCE / "scripts" / "pack.py", kind, output, folder)
 
 
 def sha256(path):
@@ -108,7 +92,7 @@ def sha256(path):
 def make(args, out, stage, version):
     builds = {"linux-x64": args.linux_build, "windows-x64": args.windows_build}
     for platform, build in builds.items():
-        check_build(build, platform, version)
+        check_release_build(build, platform, version)
 
     addon_zips = []
     for platform, build in builds.items():
@@ -116,7 +100,8 @@ def make(args, out, stage, version):
         log("installing %s into %s" % (build, name))
         tree = install_tree(build, stage, name)
         kind = PLATFORMS[platform]["archive"]
-        pack(kind, out / ("%s.%s" % (name, kind)), tree)
+        writer = write_tar_gz if kind == "tar.gz" else write_zip
+        writer(out / ("%s.%s" % (name, kind)), folder_members(tree), source_date_epoch())
         log("wrote %s.%s" % (name, kind))
         addon = stage / ("dqjulia_blender-%s-%s.zip" % (version, platform))
         shutil.copyfile(build / PLATFORMS[platform]["addon_zip"], addon)
@@ -124,38 +109,28 @@ def make(args, out, stage, version):
 
     if args.no_index:
         log("no index.json (--no-index)")
-    else:
-        tool = SOURCE / "scripts" / "extension-repo.py"
-        # TODO(issue 36, blender helper): scripts/extension-repo.py writes index.json with Blender's
-        # own `server-generate`; until it lands a release cannot be made without --no-index.
-        if not tool.is_file():
-            raise DistError(
-                "scripts/extension-repo.py is missing (the extension repository's index.json): "
-                "give --no-index to leave it out"
-            )
-        log("writing the extension repository's index.json")
-        run(sys.executable, tool, *addon_zips, "--out", out)
-        if not (out / "index.json").is_file():
-            raise DistError("scripts/extension-repo.py wrote no index.json")
-    for addon in addon_zips:  # extension-repo.py copies them; without it, here
-        if not (out / addon.name).is_file():
+        for addon in addon_zips:
             shutil.copyfile(addon, out / addon.name)
+    else:
+        log("writing the extension repository (scripts/extension-repo.py): the zips and index.json")
+        run(sys.executable, SOURCE / "scripts" / "extension-repo.py", *addon_zips, "--out", out)
+    for addon in addon_zips:
         if (out / addon.name).read_bytes() != addon.read_bytes():
             raise DistError("%s in the release differs from the build's extension zip" % addon.name)
 
     if args.no_wheels:
         log("no wheels (--no-wheels)")
     else:
-        tool = SOURCE / "scripts" / "build-wheels.py"
-        # TODO(issue 36, python helper): scripts/build-wheels.py writes the two wheels and the sdist;
-        # until it lands a release cannot be made without --no-wheels.
-        if not tool.is_file():
-            raise DistError(
-                "scripts/build-wheels.py is missing (the wheels and the sdist): give --no-wheels to leave them out"
-            )
-        log("writing the wheels and the sdist")
+        log("writing the wheels and the sdist (scripts/build-wheels.py)")
         run(
-            sys.executable, tool, "--linux-build", args.linux_build, "--windows-build", args.windows_build, "--out", out
+            sys.executable,
+            SOURCE / "scripts" / "build-wheels.py",
+            "--linux-build",
+            args.linux_build,
+            "--windows-build",
+            args.windows_build,
+            "--out",
+            out,
         )
 
     listing = {"project": "dqjulia", "version": version, "targets": {}}
@@ -185,7 +160,7 @@ def main():
     if out.exists():
         print("dist: %s exists already: give a new folder" % out, file=sys.stderr)
         return 2
-    if "SOURCE_DATE_EPOCH" not in os.environ:  # every time stamp: the commit's
+    if "SOURCE_DATE_EPOCH" not in os.environ:  # every time stamp: the commit's (build-wheels.py's too)
         try:
             stamp = run("git", "-C", SOURCE, "log", "-1", "--format=%ct").strip()
         except (DistError, OSError):
@@ -201,7 +176,7 @@ def main():
         make(args, out, stage, version)
     except BaseException as error:  # interrupted too: nothing of OUT is left
         shutil.rmtree(out, ignore_errors=True)
-        if not isinstance(error, (DistError, OSError)):
+        if not isinstance(error, (DistError, BuildTreeError, PackError, OSError)):
             raise
         print("dist: %s" % error, file=sys.stderr)
         return 1

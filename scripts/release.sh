@@ -15,11 +15,16 @@
 # - Whole or nothing: the files are made in dist/.<version>.partial-*/ and renamed to
 #   dist/<version>/ when complete; a failed run leaves no dist/<version>/ of its own, and a
 #   second run replaces the first's folder whole, never mixing the two.
-# - --no-wheels and --no-index leave those files out (a machine without the Python tooling); the
-#   folder is then dist/<version>-partial/, which cannot pass for the release.
+# - The version is VERSION's alone (scripts/set-version.sh changes it); a tag v<version> on the
+#   commit is named in the log but not required.
+# - --no-wheels and --no-index leave out the wheels and sdist (scripts/build-wheels.py), or the
+#   extension repository's index.json (scripts/extension-repo.py, which needs the bpy venv of
+#   scripts/bpy-env.sh); the folder is then dist/<version>-partial/, which cannot pass for the
+#   release.
 #
 # Needs what scripts/install-deps.sh installs (MinGW-w64 and Wine for the Windows build, whose
-# extension zip's schema is written by dqjulia.exe), and network access once for the caches.
+# extension zip's schema is written by dqjulia.exe), and network access once for the caches
+# (the third-party libraries, the bpy venv).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 dist_options=()
