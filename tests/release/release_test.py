@@ -73,14 +73,19 @@ def components(source):
 
 def build_deps_facts(source):
     """What scripts/build-deps.sh fetches (Debian source -> upstream version), its cache key's
-    versions, the patches it applies and the licence folders it fills."""
+    versions, the patches it applies (Debian source -> patch file names) and the licence folders
+    it fills."""
     text = (source / "scripts" / "build-deps.sh").read_text(encoding="utf-8")
     fetched = dict(re.findall(r"^\s*fetch (\S+) '[^_']+_([0-9][0-9.]*[0-9])", text, re.M))
     key = " ".join(re.findall(r'^\s*versions="([^"]*)"', text, re.M))
     fixes = re.search(r"^for fix in ([^;]+); do", text, re.M).group(1).split()
+    applied = {}
+    for folder, patch in re.findall(r'patch -d "\$work/src/([^"]+)"[^<\n]*< "\$here/patches/([^"]+)"', text):
+        names = [patch.replace("$fix", fix) for fix in fixes] if "$fix" in patch else [patch]
+        applied.setdefault(folder, []).extend(names)
     folders = set(re.findall(r"^\s*licences (\S+)", text, re.M))
     folders |= set(re.findall(r"^\s*system_licence (\S+)", text, re.M))
-    return fetched, key, fixes, folders
+    return fetched, key, applied, folders
 
 
 def link_inputs(map_path):
@@ -123,7 +128,10 @@ def owner_of(path, data, deps, build):
 
 def check_components(args, checks):
     data = components(args.source)
-    fetched, key, fixes, folders = build_deps_facts(args.source)
+    fetched, key, applied, folders = build_deps_facts(args.source)
+    sources = {c["debian_source"] for c in data["components"]}
+    strays = {folder: names for folder, names in applied.items() if folder not in sources}
+    checks["every patch build-deps.sh applies is a listed component's (others: %s)" % strays] = not strays
     builds = {"linux-x64": args.linux_build, "windows-x64": args.windows_build}
     deps = {target: Path(cache_value(build, "DQJ_DEPS_PREFIX")) for target, build in builds.items()}
 
@@ -148,11 +156,11 @@ def check_components(args, checks):
                 status == 0 and installed.startswith(version)
             )
         patches = [Path(p).name for p in component.get("patches", [])]
-        if patches:
-            applied = ["openvdb-10.0.1-%s.patch" % fix for fix in fixes]
-            checks["%s: the patches listed are those build-deps.sh applies %s" % (name, applied)] = sorted(
+        wanted = applied.get(source_name, [])
+        if patches or wanted:
+            checks["%s: the patches listed are those build-deps.sh applies %s" % (name, wanted)] = sorted(
                 patches
-            ) == sorted(applied) and all((args.source / p).is_file() for p in component["patches"])
+            ) == sorted(wanted) and all((args.source / p).is_file() for p in component["patches"])
         for target in component["in"]:
             folder = deps[target] / "share" / "licenses" / component["licenses"]
             record = (folder / "SOURCE").read_text(encoding="utf-8") if (folder / "SOURCE").is_file() else ""
