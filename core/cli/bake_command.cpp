@@ -46,11 +46,13 @@ std::vector<Job> plan(const BakeFlags& flags, const Params& params) {
         }
     }
     std::vector<Job> todo;
+    std::vector<NamedPath> outputs;
     for (Job& job : jobs) {
         if (flags.skips(job.path)) continue;
-        checkOutputPath(job.path, flags.force);
+        outputs.push_back({"--output", job.path});
         todo.push_back(std::move(job));
     }
+    checkOutputs(outputs, flags.fractal.inputs(), flags.force);
     return todo;
 }
 

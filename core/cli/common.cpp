@@ -12,7 +12,9 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <map>
 
+#include "atomic_file.hpp"
 #include "dqjulia/estimate.hpp"
 #include "file_names.hpp"
 
@@ -45,6 +47,44 @@ double nowSeconds() {
     using namespace std::chrono;
     return duration<double>(steady_clock::now().time_since_epoch()).count();
 }
+
+/// A stream buffer that passes text on to another with its control characters escaped
+/// (printableText). A trailing first byte of a C1 control (0xc2) waits for the next write.
+class EscapingBuffer : public std::streambuf {
+public:
+    explicit EscapingBuffer(std::streambuf* target) : target_(target) {}
+    ~EscapingBuffer() override {
+        if (!pending_.empty()) target_->sputn(pending_.data(), std::streamsize(pending_.size()));
+    }
+
+protected:
+    int_type overflow(int_type ch) override {
+        if (traits_type::eq_int_type(ch, traits_type::eof())) return traits_type::not_eof(ch);
+        const char byte = traits_type::to_char_type(ch);
+        return xsputn(&byte, 1) == 1 ? ch : traits_type::eof();
+    }
+    std::streamsize xsputn(const char* data, std::streamsize count) override {
+        std::string text = std::move(pending_);
+        pending_.clear();
+        text.append(data, std::size_t(count));
+        if (!text.empty() && static_cast<unsigned char>(text.back()) == 0xc2) {
+            pending_ = text.substr(text.size() - 1);
+            text.pop_back();
+        }
+        const std::string escaped = printableText(text);
+        return target_->sputn(escaped.data(), std::streamsize(escaped.size())) == std::streamsize(escaped.size())
+                   ? count
+                   : 0;
+    }
+    int sync() override { return target_->pubsync(); }
+
+private:
+    std::streambuf* target_;
+    std::string pending_;
+};
+
+/// Where the progress bar draws: standard error's own buffer, not the escaping one.
+std::streambuf* terminalBuffer = nullptr;
 
 std::string formatDuration(double seconds) {
     const long total = long(seconds + 0.5);
@@ -157,10 +197,19 @@ Params FractalOptions::load() const {
     return params;
 }
 
+std::vector<NamedPath> FractalOptions::inputs() const {
+    if (paramsFile.empty()) return {};
+    return {{"--params", paramsFile}};
+}
+
 void checkOutputPath(const std::string& path, bool force, const std::string& flag) {
     namespace fs = std::filesystem;
     std::error_code error;
     if (path.empty()) throw ParamError("output.path", flag + " is empty; give a file name");
+#ifdef _WIN32
+    if (const std::string problem = windowsNameProblem(path); !problem.empty())
+        throw ParamError("output.path", flag + " '" + path + "': " + problem);
+#endif
     const fs::path target = pathFromUtf8(path);
     if (fs::is_directory(target, error))
         throw ParamError("output.path", flag + " '" + path + "' is a folder; give a file name");
@@ -185,19 +234,64 @@ void checkOutputPath(const std::string& path, bool force, const std::string& fla
     }
 }
 
-void checkDistinctOutputs(const std::vector<std::pair<std::string, std::string>>& outputs) {
+void checkDistinctOutputs(const std::vector<NamedPath>& outputs) {
     namespace fs = std::filesystem;
-    std::vector<fs::path> resolved;
-    for (const auto& [flag, path] : outputs) {
+    std::map<fs::path, std::size_t> seen;
+    for (std::size_t index = 0; index < outputs.size(); ++index) {
+        const std::string& path = outputs[index].path;
         std::error_code error;
         fs::path canonical = fs::weakly_canonical(fs::absolute(pathFromUtf8(path), error), error);
-        resolved.push_back(error ? pathFromUtf8(path).lexically_normal() : canonical);
+        const auto [at, added] = seen.emplace(error ? pathFromUtf8(path).lexically_normal() : canonical, index);
+        if (!added)
+            throw ParamError("output.path", outputs[at->second].flag + " and " + outputs[index].flag + " both name '" +
+                                                path + "'; give them different files");
     }
-    for (std::size_t a = 0; a < outputs.size(); ++a)
-        for (std::size_t b = 0; b < a; ++b)
-            if (resolved[a] == resolved[b])
-                throw ParamError("output.path", outputs[b].first + " and " + outputs[a].first + " both name '" +
-                                                    outputs[a].second + "'; give them different files");
+}
+
+void checkInputsKept(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs) {
+    std::map<FileIdentity, const NamedPath*> read;
+    for (const NamedPath& input : inputs)
+        if (const auto identity = fileIdentity(input.path)) read.emplace(*identity, &input);
+    if (read.empty()) return;
+    for (const NamedPath& output : outputs) {
+        const auto identity = fileIdentity(output.path);
+        const auto found = identity ? read.find(*identity) : read.end();
+        if (found == read.end()) continue;
+        const NamedPath& input = *found->second;
+        throw ParamError("output.path",
+                         output.flag + " '" + output.path + "' is " +
+                             (input.path == output.path ? "" : "the same file as ") + input.flag + " '" + input.path +
+                             "', which this run reads: a run never writes over its own input, not even with "
+                             "--force; write to another name");
+    }
+}
+
+void checkOutputs(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs, bool force) {
+    checkInputsKept(outputs, inputs);  // first: "exists; pass --force" would be the wrong advice
+    checkDistinctOutputs(outputs);
+    for (const NamedPath& output : outputs) checkOutputPath(output.path, force, output.flag);
+}
+
+MessageEscaping::MessageEscaping()
+    : out_(std::cout.rdbuf()),
+      err_(std::cerr.rdbuf()),
+      log_(std::clog.rdbuf()),
+      escapedOut_(std::make_unique<EscapingBuffer>(out_)),
+      escapedErr_(std::make_unique<EscapingBuffer>(err_)) {
+    terminalBuffer = err_;
+    std::cout.rdbuf(escapedOut_.get());
+    std::cerr.rdbuf(escapedErr_.get());
+    std::clog.rdbuf(escapedErr_.get());  // a library's log lines too (its own object, the same stderr)
+}
+
+MessageEscaping::~MessageEscaping() {
+    std::cout.flush();
+    std::cerr.flush();
+    std::clog.flush();
+    std::cout.rdbuf(out_);
+    std::cerr.rdbuf(err_);
+    std::clog.rdbuf(log_);
+    terminalBuffer = nullptr;
 }
 
 int reportErrors(const std::string& command, const std::function<int()>& body) {
@@ -252,8 +346,10 @@ bool ProgressBar::update(double fraction) {
         fraction > 0.02 && fraction < 1.0 ? " ETA " + formatDuration(elapsed / fraction * (1.0 - fraction)) : "";
     char percent[16];
     std::snprintf(percent, sizeof percent, "%3d%%", int(fraction * 100.0));
-    std::cerr << "\r" << label_ << " [" << bar << "] " << percent << "  " << formatDuration(elapsed) << eta
-              << (status_.empty() ? "" : "  ") << status_ << "\x1b[K" << std::flush;
+    // Drawn past the messages' escaping (its own \r and erase-line codes), the label and status escaped here.
+    std::ostream terminal(terminalBuffer ? terminalBuffer : std::cerr.rdbuf());
+    terminal << "\r" << printableText(label_) << " [" << bar << "] " << percent << "  " << formatDuration(elapsed)
+             << eta << (status_.empty() ? "" : "  ") << printableText(status_) << "\x1b[K" << std::flush;
     drawn_ = true;
     return true;
 }

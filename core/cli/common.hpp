@@ -2,7 +2,9 @@
 // loading parameters with flag overrides, errors and the progress bar.
 #pragma once
 
+#include <memory>
 #include <optional>
+#include <streambuf>
 #include <string>
 #include <vector>
 
@@ -15,6 +17,12 @@ namespace dqj::cli {
 
 /// Exit codes: 0 success, 1 failure while working, 2 bad input, 130 interrupted.
 enum ExitCode { kSuccess = 0, kFailure = 1, kBadInput = 2, kInterrupted = 130 };
+
+/// A file a run reads or writes, with the flag (or the words) that name it in messages.
+struct NamedPath {
+    std::string flag;
+    std::string path;
+};
 
 /// --params and the fractal and slice flags, shared by render, eval and inspect.
 struct FractalOptions {
@@ -32,6 +40,8 @@ struct FractalOptions {
     Params load() const;
     /// Applies the flags to `params` without validating. Throws ParamError for malformed flags.
     void applyTo(Params& params) const;
+    /// The files the flags read: --params, if given.
+    std::vector<NamedPath> inputs() const;
 };
 
 /// Checks an output path before any long work starts: refuses an empty name, an existing file
@@ -40,12 +50,41 @@ struct FractalOptions {
 void checkOutputPath(const std::string& path, bool force, const std::string& flag = "--output");
 
 /// Refuses two outputs of one run that name the same file (one would silently replace the
-/// other): `outputs` holds (flag, path) pairs. Throws ParamError naming both flags.
-void checkDistinctOutputs(const std::vector<std::pair<std::string, std::string>>& outputs);
+/// other). Throws ParamError naming both flags.
+void checkDistinctOutputs(const std::vector<NamedPath>& outputs);
+
+/// Refuses, with or without --force, an output that is one of the run's inputs: the same file by
+/// its identity (fileIdentity), so a symbolic or hard link to an input is caught too. --force
+/// consents to replacing an old output, never an input of the same run. Throws ParamError naming
+/// both. Costs a stat of each path.
+void checkInputsKept(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs);
+
+/// Every output of a run checked before the work: none is one of its inputs (checkInputsKept),
+/// no two name one file (checkDistinctOutputs), and each passes checkOutputPath.
+void checkOutputs(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs, bool force);
 
 /// What writers do with a file that exists when they publish: without --force it is kept (and
 /// the write fails), even if it appeared while the work ran.
 inline Existing existingPolicy(bool force) { return force ? Existing::Replace : Existing::Keep; }
+
+/// While it lives, every character written to std::cout, std::cerr and std::clog (the command's
+/// messages, the argument parser's and any library's) goes through printableText(), so no name
+/// or value can drive the terminal: control characters arrive as \xNN. Only the progress bar
+/// draws its own control codes, through the buffer standard error had before (its label escaped).
+class MessageEscaping {
+public:
+    MessageEscaping();
+    ~MessageEscaping();
+    MessageEscaping(const MessageEscaping&) = delete;
+    MessageEscaping& operator=(const MessageEscaping&) = delete;
+
+private:
+    std::streambuf* out_;
+    std::streambuf* err_;
+    std::streambuf* log_;
+    std::unique_ptr<std::streambuf> escapedOut_;
+    std::unique_ptr<std::streambuf> escapedErr_;
+};
 
 /// Runs `body`, printing "dqjulia: <message>" for errors and returning the exit code.
 int reportErrors(const std::string& command, const std::function<int()>& body);

@@ -1,13 +1,17 @@
 // dqjulia explore: a contact sheet of random constants (seeded), one parameter file per tile.
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <vector>
 
 #include "commands.hpp"
 #include "common.hpp"
 #include "contact_sheet.hpp"
 #include "explore.hpp"
+#include "atomic_file.hpp"
 #include "dqjulia/render.hpp"
 #include "file_names.hpp"
+#include "image_writer.hpp"
 
 namespace dqj::cli {
 namespace {
@@ -25,6 +29,17 @@ struct ExploreCommandOptions {
     bool quiet = false;
 };
 
+/// The folders a run made for its files (deepest first): removed again, if still empty, unless kept.
+struct MadeFolders {
+    std::vector<std::filesystem::path> paths;
+    bool keep = false;
+    ~MadeFolders() {
+        std::error_code error;
+        if (!keep)
+            for (const std::filesystem::path& path : paths) std::filesystem::remove(path, error);  // empty ones only
+    }
+};
+
 int runExplore(const ExploreCommandOptions& options) {
     Params base = options.fractal.load();
     base.render.width = options.width;
@@ -35,10 +50,37 @@ int runExplore(const ExploreCommandOptions& options) {
     namespace fs = std::filesystem;
     const fs::path folder = pathFromUtf8(options.folder);
     const fs::path sheetPath = folder / "sheet.png";
+    // The folder is checked before it is made (a name Windows cannot hold, a file or a dangling
+    // link in its place); the folders made here are removed again unless the run publishes its files.
+#ifdef _WIN32
+    if (const std::string problem = windowsNameProblem(options.folder); !problem.empty())
+        throw ParamError("output.path", "--output '" + options.folder + "': " + problem);
+#endif
     std::error_code error;
+    if (fs::is_symlink(folder, error) && !fs::exists(folder, error))
+        throw ParamError("output.path", "--output '" + options.folder + "' is a symbolic link to '" +
+                                            utf8FromPath(fs::read_symlink(folder, error)) +
+                                            "', which does not exist; give a folder");
+    if (fs::exists(folder, error) && !fs::is_directory(folder, error))
+        throw ParamError("output.path",
+                         "--output '" + options.folder + "' is a file, not a folder; explore writes a folder of files");
+    MadeFolders made;  // declared before the files: removed after their temporary files
+    for (fs::path at = folder; !at.empty() && !fs::exists(at, error); at = at.parent_path()) made.paths.push_back(at);
     fs::create_directories(folder, error);
-    if (error) throw std::runtime_error("cannot create folder '" + options.folder + "': " + error.message());
-    checkOutputPath(utf8FromPath(sheetPath), options.force, "--output");
+    if (error)
+        throw ParamError("output.path",
+                         "--output '" + options.folder + "': cannot create the folder: " + error.message());
+    // The sheet and every tile's picture and parameter file: checked now, published together at the end.
+    auto tileName = [](std::size_t index) {
+        char name[32];
+        std::snprintf(name, sizeof name, "tile_%02zu", index + 1);
+        return std::string(name);
+    };
+    std::vector<NamedPath> outputs{{"--output", utf8FromPath(sheetPath)}};
+    for (std::size_t index = 0; index < std::size_t(options.count); ++index)
+        for (const char* extension : {".png", ".json"})
+            outputs.push_back({"--output", utf8FromPath(folder / (tileName(index) + extension))});
+    checkOutputs(outputs, options.fractal.inputs(), options.force);
 
     ExploreOptions exploreOptions;
     exploreOptions.seed = options.seed;
@@ -49,24 +91,27 @@ int runExplore(const ExploreCommandOptions& options) {
                                  " attempts; try fewer iterations or another slice");
 
     ProgressBar progress("exploring", options.quiet);
+    AtomicFileSet files(existingPolicy(options.force));
     std::vector<SheetTile> tiles;
     for (std::size_t index = 0; index < found.tiles.size(); ++index) {
         Params tile = found.tiles[index];
-        char name[32];
-        std::snprintf(name, sizeof name, "tile_%02zu", index + 1);
-        tile.output.path = utf8FromPath(folder / (std::string(name) + ".png"));
+        const std::string name = tileName(index);
+        tile.output.path = utf8FromPath(folder / (name + ".png"));
         // Each tile's share of the progress bar; Ctrl-C stops between and inside tiles.
         const double start = double(index) / found.tiles.size(), share = 1.0 / found.tiles.size();
         const ProgressCallback callback = progress.callback();
         const RenderResult result = render(tile, [&](double fraction) { return callback(start + share * fraction); });
-        writeImage(result.image, tile.output.path, ImageFormat::Png8);
-        saveParams(tile, utf8FromPath(folder / (std::string(name) + ".json")));
-        tiles.push_back({result.image, std::string(name) + "  " + constantText(tile.fractal.c, 3)});
+        writeImage(result.image, files.add(tile.output.path), ImageFormat::Png8);
+        files.add(utf8FromPath(folder / (name + ".json"))).stream() << toJson(tile);
+        tiles.push_back({result.image, name + "  " + constantText(tile.fractal.c, 3)});
     }
     progress.finish();
     SheetLayout layout;
     layout.columns = options.columns;
-    writeImage(composeSheet(tiles, layout), utf8FromPath(sheetPath), ImageFormat::Png8, existingPolicy(options.force));
+    writeImage(composeSheet(tiles, layout), files.add(utf8FromPath(sheetPath)), ImageFormat::Png8);
+    if (interrupted()) throw Cancelled();  // a signal in the last moments of the work: write nothing
+    files.commit();
+    made.keep = true;
     if (!options.quiet)
         std::cerr << "wrote " << utf8FromPath(sheetPath) << " and " << tiles.size()
                   << " tiles (tile_NN.png, tile_NN.json) to " << options.folder << "; " << found.skippedEmpty << " of "
@@ -91,7 +136,7 @@ Runner addExploreCommand(CLI::App& app) {
     command->add_option("-s,--samples", options->samples, "Anti-aliasing per tile: S x S rays a pixel")
         ->check(CLI::Range(1, 8));
     command->add_option("-o,--output", options->folder, "Folder for the sheet, tiles and parameter files");
-    command->add_flag("-f,--force", options->force, "Overwrite an existing sheet");
+    command->add_flag("-f,--force", options->force, "Overwrite an existing sheet, tiles and parameter files");
     command->add_flag("-q,--quiet", options->quiet, "No progress bar or summary");
     return [options] { return reportErrors("explore", [&] { return runExplore(*options); }); };
 }

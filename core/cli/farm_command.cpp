@@ -31,7 +31,6 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "dqjulia/dqjulia.h"
-#include "dqjulia/files.hpp"
 #include "dqjulia/tiles.hpp"
 #include "file_names.hpp"
 
@@ -113,8 +112,8 @@ std::string thisExecutable() {
 #endif
 }
 
-/// Plans the job and writes the parameter file every task reads. Throws ParamError.
-FarmPlan plan(const FarmFlags& flags, const std::string& fileFlag, const std::string& file) {
+/// Plans the job and checks its files: the parameter file every task reads and `jobFiles`. Throws ParamError.
+FarmPlan plan(const FarmFlags& flags, std::vector<NamedPath> jobFiles) {
     const BakeFlags& bake = flags.bake;
     FarmPlan plan;
     plan.params = bake.load();
@@ -134,9 +133,8 @@ FarmPlan plan(const FarmFlags& flags, const std::string& fileFlag, const std::st
     plan.name = flags.name.empty() ? "dqjulia-" + utf8FromPath(pathFromUtf8(plan.output).stem()) : flags.name;
     plan.dqjulia = thisExecutable();
     plan.paramsPath = withoutExtension(plan.output) + ".params.json";
-    checkOutputPath(plan.paramsPath, bake.force, "the parameter file");
-    checkOutputPath(file, bake.force, fileFlag);
-    checkDistinctOutputs({{"the parameter file", plan.paramsPath}, {fileFlag, file}});
+    jobFiles.insert(jobFiles.begin(), {"the parameter file", plan.paramsPath});
+    checkOutputs(jobFiles, bake.fractal.inputs(), bake.force);
     return plan;
 }
 
@@ -227,15 +225,18 @@ int runSlurm(const FarmFlags& flags) {
                            : flags.file;
     const std::string mergeScript =
         withoutExtension(script) + ".merge" + utf8FromPath(pathFromUtf8(script).extension());
-    FarmPlan job = plan(flags, "--script", script);
-    if (job.tiling) checkOutputPath(mergeScript, flags.bake.force, "the merge script");
+    std::vector<NamedPath> jobFiles{{"--script", script}};
+    if (!flags.bake.tiles.empty()) jobFiles.push_back({"the merge script", mergeScript});
+    FarmPlan job = plan(flags, jobFiles);
     if (job.chunks() * job.tiles() > kSlurmMaxArraySize)
         std::cerr << "dqjulia farm slurm: warning: " << job.chunks() * job.tiles()
                   << " array tasks: more than Slurm's default MaxArraySize allows (" << kSlurmMaxArraySize
                   << "); raise --chunk, or the cluster's MaxArraySize\n";
-    saveParams(job.params, job.paramsPath, existingPolicy(flags.bake.force));
-    writeTextFile(script, slurmBakeScript(flags, job), existingPolicy(flags.bake.force));
-    if (job.tiling) writeTextFile(mergeScript, slurmMergeScript(flags, job), existingPolicy(flags.bake.force));
+    AtomicFileSet files(existingPolicy(flags.bake.force));  // all of them or none
+    files.add(job.paramsPath).stream() << toJson(job.params);
+    files.add(script).stream() << slurmBakeScript(flags, job);
+    if (job.tiling) files.add(mergeScript).stream() << slurmMergeScript(flags, job);
+    files.commit();
     std::cerr << "wrote " << job.paramsPath << ", " << script << (job.tiling ? " and " + mergeScript : "") << " ("
               << job.describe() << ")\n";
     const std::string submitBake = "sbatch --parsable " + shellQuote(script);
@@ -293,7 +294,7 @@ int runOpenJd(const FarmFlags& flags) {
         flags.file.empty()
             ? withoutExtension(utf8FromPath(fs::absolute(pathFromUtf8(flags.bake.output)))) + ".openjd.json"
             : flags.file;
-    FarmPlan job = plan(flags, "--template", file);
+    FarmPlan job = plan(flags, {{"--template", file}});
     if (job.chunks() > kMaxOpenJdChunks)
         throw ParamError("frames", std::to_string(job.chunks()) +
                                        " chunks of frames: an Open Job Description task "
@@ -325,8 +326,10 @@ int runOpenJd(const FarmFlags& flags) {
            {"description", "The bake's output (frames: NAME_0001.vdb, ...), on shared storage"}}}},
         {"steps", nlohmann::ordered_json::array({openJdStep("Bake", job, false)})}};
     if (job.tiling) document["steps"].push_back(openJdStep("Merge", job, true));
-    saveParams(job.params, job.paramsPath, existingPolicy(flags.bake.force));
-    writeTextFile(file, document.dump(2) + "\n", existingPolicy(flags.bake.force));
+    AtomicFileSet files(existingPolicy(flags.bake.force));  // both or neither
+    files.add(job.paramsPath).stream() << toJson(job.params);
+    files.add(file).stream() << document.dump(2) << "\n";
+    files.commit();
     std::cerr << "wrote " << job.paramsPath << " and " << file << " (" << job.describe() << ")\n";
     std::cout << "check and run it locally with:\n  openjd check " << shellQuote(file) << "\n  openjd run "
               << shellQuote(file) << (job.tiling ? " --step Merge --run-dependencies" : " --step Bake") << "\n"

@@ -16,6 +16,8 @@ namespace {
 
 int run(int argc, char** argv) {
     using namespace dqj::cli;
+    // Every message escaped from here on, the argument parser's (a missing --params file) included.
+    const MessageEscaping escaping;
     CLI::App app{
         "dqjulia: dual-quaternion Julia fractals (zeta <- zeta^2 + c in 8-D, sliced to 3-D).\n"
         "Parameters come from a JSON file (--params) and flags, which override the file.",

@@ -31,8 +31,9 @@ int runMerge(const MergeFlags& flags) {
     if (!flags.inputs.empty() && bake.frameRange())
         throw ParamError("frames", "--frames goes with --tiles: the tiles' names come from --output then");
 
-    // Each output and its tiles, all checked before the first merge starts.
+    // Each output and its tiles, all checked before the first merge starts: no output is one of the tiles.
     std::vector<std::pair<std::string, std::vector<std::string>>> merges;
+    std::vector<NamedPath> outputs, tiles;
     for (const auto& [frame, path] : framePaths(bake)) {
         std::vector<std::string> inputs = flags.inputs;
         for (int index = 1; tiling && index <= tileCount(*tiling); ++index) inputs.push_back(tilePath(path, index));
@@ -43,9 +44,11 @@ int runMerge(const MergeFlags& flags) {
                 missing += (missing.empty() ? "'" : ", '") + input + "'";
         if (!missing.empty())
             throw ParamError("tiles", "no tile " + missing + ": bake it first (dqjulia bake --tiles)");
-        checkOutputPath(path, bake.force);
+        outputs.push_back({"--output", path});
+        for (const std::string& input : inputs) tiles.push_back({"the tile", input});
         merges.emplace_back(path, std::move(inputs));
     }
+    checkOutputs(outputs, tiles, bake.force);
     const ThreadLimit threads(bake.threadCount());
     for (const auto& [path, inputs] : merges) {
         MergeStats stats;

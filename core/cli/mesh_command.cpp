@@ -30,8 +30,11 @@ int runMesh(const BakeFlags& flags) {
         frames.push_back(frame);
         perFrame.push_back(paramsAtFrame(params, frame));
         paths.push_back(path);
-        checkOutputPath(paths.back(), flags.force);
     }
+    std::vector<NamedPath> outputs;
+    outputs.reserve(paths.size());
+    for (const std::string& path : paths) outputs.push_back({"--output", path});
+    checkOutputs(outputs, flags.fractal.inputs(), flags.force);
     const ThreadLimit threads(flags.threadCount());
 
     for (std::size_t index = 0; index < frames.size(); ++index) {

@@ -55,16 +55,15 @@ int runPovray(const PovrayOptions& options) {
     // Check every output before the work: existing files need --force. An identical copy of
     // the include is fine (several scenes share one folder); a different one is not replaced silently.
     const PovrayFiles files = povrayFiles(params, options.output, write);
-    std::vector<std::pair<std::string, std::string>> outputs;
-    for (const auto& [flag, path] : {std::pair<std::string, std::string>{"--output", files.scene},
-                                     {"--df3 (grid)", files.df3},
-                                     {"--df3 (scene)", files.df3Scene},
-                                     {"the include copy", files.include}})
-        if (!path.empty()) outputs.emplace_back(flag, path);
-    checkDistinctOutputs(outputs);
-    if (!files.scene.empty()) checkOutputPath(files.scene, options.force);
-    if (!files.df3.empty()) checkOutputPath(files.df3, options.force, "--df3");
-    if (!files.df3Scene.empty()) checkOutputPath(files.df3Scene, options.force, "--df3");
+    std::vector<NamedPath> outputs;
+    for (const NamedPath& output : {NamedPath{"--output", files.scene}, NamedPath{"--df3 (grid)", files.df3},
+                                    NamedPath{"--df3 (scene)", files.df3Scene}})
+        if (!output.path.empty()) outputs.push_back(output);
+    std::vector<NamedPath> all = outputs;
+    if (!files.include.empty()) all.push_back({"the include copy", files.include});
+    checkInputsKept(all, options.fractal.inputs());
+    checkDistinctOutputs(all);
+    for (const NamedPath& output : outputs) checkOutputPath(output.path, options.force, output.flag);
     if (!files.include.empty()) {
         std::ifstream existing(pathFromUtf8(files.include), std::ios::binary);
         std::ostringstream text;

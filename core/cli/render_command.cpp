@@ -8,6 +8,7 @@
 #include "dqjulia/image.hpp"
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/render.hpp"
+#include "image_writer.hpp"
 #include "voxel_render.hpp"
 
 namespace dqj::cli {
@@ -70,12 +71,14 @@ Params loadRenderParams(const RenderOptions& options) {
 
 int runRender(const RenderOptions& options) {
     const Params params = loadRenderParams(options);
-    checkOutputPath(params.output.path, options.force);
-    if (options.saveParamsGiven) {
-        checkOutputPath(options.saveParams, options.force, "--save-params");
-        checkDistinctOutputs({{"--output", params.output.path}, {"--save-params", options.saveParams}});
-        saveParams(params, options.saveParams, existingPolicy(options.force));
-    }
+    std::vector<NamedPath> outputs{{"--output", params.output.path}};
+    if (options.saveParamsGiven) outputs.push_back({"--save-params", options.saveParams});
+    std::vector<NamedPath> inputs = options.fractal.inputs();
+    if (!options.voxels.empty()) inputs.push_back({"--voxels", options.voxels});
+    checkOutputs(outputs, inputs, options.force);
+    // The image and the parameter file are published together, once the image is done: both or neither.
+    AtomicFileSet files(existingPolicy(options.force));
+    if (options.saveParamsGiven) files.add(options.saveParams).stream() << toJson(params);
     // Say up front when the slice is provably empty: an empty picture needs a reason.
     const std::string provenEmpty = provenEmptyReason(params);
     if (!provenEmpty.empty()) std::cerr << "dqjulia render: warning: " << provenEmpty << "\n";
@@ -85,7 +88,8 @@ int runRender(const RenderOptions& options) {
                                                        : renderVoxels(params, options.voxels, progress.callback());
     progress.finish();
     if (interrupted()) throw Cancelled();  // a signal in the last moments of the work: write nothing
-    writeImage(result.image, params.output.path, formatFor(params.output), existingPolicy(options.force));
+    writeImage(result.image, files.add(params.output.path), formatFor(params.output));
+    files.commit();
 
     const RenderStats& stats = result.stats;
     if (stats.hitPixels == 0) {
@@ -100,7 +104,7 @@ int runRender(const RenderOptions& options) {
     if (!options.quiet)
         std::cerr << "wrote " << params.output.path << " (" << params.render.width << "x" << params.render.height
                   << ", " << stats.hitPixels << " pixels on the surface, " << std::fixed << std::setprecision(2)
-                  << stats.seconds << " s)\n";
+                  << stats.seconds << " s)" << (options.saveParamsGiven ? " and " + options.saveParams : "") << "\n";
     if (options.stats)
         std::cout << "rays " << stats.rays << "\nsteps " << stats.steps << "\nsteps_per_ray "
                   << (stats.rays ? double(stats.steps) / double(stats.rays) : 0.0) << "\nevaluations "

@@ -21,7 +21,9 @@ int runSheet(const SheetOptions& options) {
     if (!options.labels.empty() && options.labels.size() != options.images.size())
         throw ParamError("label", "give one --label per --tile (" + std::to_string(options.images.size()) + " tiles, " +
                                       std::to_string(options.labels.size()) + " labels)");
-    checkOutputPath(options.output, options.force);
+    std::vector<NamedPath> inputs;
+    for (const std::string& image : options.images) inputs.push_back({"--tile", image});
+    checkOutputs({{"--output", options.output}}, inputs, options.force);
     std::vector<SheetTile> tiles;
     for (std::size_t index = 0; index < options.images.size(); ++index)
         tiles.push_back(

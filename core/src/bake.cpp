@@ -30,6 +30,7 @@
 #include <tbb/parallel_for.h>
 
 #include "atomic_file.hpp"
+#include "attribute_reach.hpp"
 #include "level_set.hpp"
 #include "mesh_distance.hpp"
 #include "nearest_seed.hpp"
@@ -65,12 +66,10 @@ MemoryModel bakeMemoryModel(const BakeSettings& bake) {
 /// colours through the depth light reaches, not a thin shell over black.
 openvdb::MaskTree attributeVoxels(const openvdb::FloatGrid& surface, const BakeSettings& bake) {
     openvdb::MaskTree mask(surface.tree(), false, openvdb::TopologyCopy());
-    const int depth = int(std::ceil(bake.colorDepth * bake.resolution));
-    const int inside = int(std::ceil(bake.bandWidth));  // what the band already covers
-    if (depth > inside) {
-        // 26-neighbour steps: at least `depth` voxels deep in every direction (up to sqrt 3 times
-        // that along the diagonals).
-        openvdb::tools::dilateActiveValues(mask, depth - inside, openvdb::tools::NN_FACE_EDGE_VERTEX,
+    if (const int steps = attributeDilation(bake); steps > 0) {
+        // 26-neighbour steps beyond the band: at least attributeDepth() voxels deep in every
+        // direction (up to sqrt 3 times that along the diagonals).
+        openvdb::tools::dilateActiveValues(mask, steps, openvdb::tools::NN_FACE_EDGE_VERTEX,
                                            openvdb::tools::IGNORE_TILES);
         // Keep the band, and of the rest only the inside (negative distance): never the air.
         std::vector<openvdb::MaskTree::LeafNodeType*> leaves;
@@ -187,9 +186,10 @@ typename GridT::Ptr seedValueGrid(const openvdb::Int32Tree& ids, const std::vect
 /// nearest to it, so the inside shows, through the depth light reaches, the colour its surface
 /// has, as the mesh's vertices and the preview do; a voxel's own orbit would give the inside's
 /// colour instead (bounded orbits: the palette's far end). One fractal evaluation per surface
-/// seed (surfaceSeeds), then each voxel takes its nearest seed (nearestSeeds), one propagation
-/// for all the grids; colour and smooth count from coloring.hpp. A tile works on all it baked,
-/// its halo included, and keeps its box.
+/// seed (surfaceSeeds), then each voxel takes its nearest seed (nearestSeeds, in at most
+/// attributeRounds() rounds), one propagation for all the grids; colour and smooth count from
+/// coloring.hpp. A tile works on all it baked, its halo included, and keeps its box, where every
+/// voxel's seed is the whole bake's (tileHalo says why).
 void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, const openvdb::CoordBBox* kept,
                        const ProgressCallback& progress, BakeStats& stats, openvdb::GridPtrVec& grids) {
     const bool color = hasGrid(params.bake, BakeGrid::Color);
@@ -200,7 +200,8 @@ void addAttributeGrids(const Params& params, const openvdb::FloatGrid& surface, 
     SurfaceSeeds seeds = surfaceSeeds(params, surface);
     stats.evaluated += seeds.voxels.size();
     if (progress && !progress(0.3)) throw Cancelled();
-    openvdb::Int32Tree::Ptr ids = nearestSeeds(attributeVoxels(surface, params.bake), seeds.voxels, seeds.points);
+    openvdb::Int32Tree::Ptr ids =
+        nearestSeeds(attributeVoxels(surface, params.bake), seeds.voxels, seeds.points, attributeRounds(params.bake));
     seeds.voxels = {};
     seeds.points = {};
     if (progress && !progress(0.8)) throw Cancelled();

@@ -1,6 +1,7 @@
 // Image files: 8- and 16-bit sRGB PNG through libpng, linear EXR with depth and normals
 // through OpenEXR. Every write goes through AtomicFile, so a failed write leaves nothing behind.
 #include "dqjulia/image.hpp"
+#include "image_writer.hpp"
 
 #include <algorithm>
 #include <array>
@@ -214,7 +215,7 @@ void checkImage(const Image& image, const std::string& path) {
         throw std::runtime_error(AtomicFile::failureMessage(path, "the normal buffer has the wrong size"));
 }
 
-void writePng(const Image& image, const std::string& path, int bitDepth, Existing existing) {
+void writePng(const Image& image, AtomicFile& target, int bitDepth) {
     const std::size_t width = image.width;
     const std::size_t height = image.height;
     const std::size_t bytesPerSample = bitDepth == 16 ? 2 : 1;
@@ -238,12 +239,12 @@ void writePng(const Image& image, const std::string& path, int bitDepth, Existin
     std::vector<png_bytep> rows(height);
     for (std::size_t row = 0; row < height; ++row) rows[row] = &data[row * width * 3 * bytesPerSample];
 
-    AtomicFile target(path, existing);
     PngError error;
     if (!writePngRows(&target.stream(), static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), bitDepth,
-                      rows.data(), &error))
-        throw std::runtime_error(AtomicFile::failureMessage(path, error.message));
-    target.commit();  // reports a failed write (a full disk) with its reason
+                      rows.data(), &error)) {
+        target.checkWrites();  // a failed write (a full disk) with its reason
+        throw std::runtime_error(AtomicFile::failureMessage(target.path(), error.message));
+    }
 }
 
 /// OpenEXR's output through AtomicFile's checked stream.
@@ -261,7 +262,7 @@ private:
     std::ostream& out_;
 };
 
-void writeExr(const Image& image, const std::string& path, Existing existing) {
+void writeExr(const Image& image, AtomicFile& target) {
     const std::size_t width = image.width;
     const std::size_t height = image.height;
     const std::size_t pixels = width * height;
@@ -308,17 +309,15 @@ void writeExr(const Image& image, const std::string& path, Existing existing) {
         }
     }
 
-    AtomicFile target(path, existing);
     try {
-        ExrStream stream(target.stream(), path);
+        ExrStream stream(target.stream(), target.path());
         Imf::OutputFile file(stream, header);
         file.setFrameBuffer(frame);
         file.writePixels(image.height);
     } catch (const std::exception& error) {
-        if (!target.stream()) target.commit();  // throws with the write's reason ("No space left on device")
-        throw std::runtime_error(AtomicFile::failureMessage(path, error.what()));
+        target.checkWrites();  // throws with the write's reason ("No space left on device")
+        throw std::runtime_error(AtomicFile::failureMessage(target.path(), error.what()));
     }
-    target.commit();
 }
 
 }  // namespace
@@ -326,14 +325,21 @@ void writeExr(const Image& image, const std::string& path, Existing existing) {
 
 std::uint8_t linearToSrgb8(float linear) { return srgb8Table()(linear); }
 
-void writeImage(const Image& image, const std::string& path, ImageFormat format, Existing existing) {
-    checkImage(image, path);
+void writeImage(const Image& image, AtomicFile& target, ImageFormat format) {
+    checkImage(image, target.path());
     switch (format) {
-        case ImageFormat::Png8: writePng(image, path, 8, existing); return;
-        case ImageFormat::Png16: writePng(image, path, 16, existing); return;
-        case ImageFormat::Exr: writeExr(image, path, existing); return;
+        case ImageFormat::Png8: writePng(image, target, 8); return;
+        case ImageFormat::Png16: writePng(image, target, 16); return;
+        case ImageFormat::Exr: writeExr(image, target); return;
     }
-    throw std::runtime_error(AtomicFile::failureMessage(path, "unknown image format"));
+    throw std::runtime_error(AtomicFile::failureMessage(target.path(), "unknown image format"));
+}
+
+void writeImage(const Image& image, const std::string& path, ImageFormat format, Existing existing) {
+    checkImage(image, path);  // before the file is opened
+    AtomicFile target(path, existing);
+    writeImage(image, target, format);
+    target.commit();  // reports a failed write (a full disk) with its reason
 }
 
 Image readPng(const std::string& path) {

@@ -101,8 +101,9 @@ private:
 }  // namespace
 
 openvdb::Int32Tree::Ptr nearestSeeds(const openvdb::MaskTree& region, const std::vector<openvdb::Coord>& voxels,
-                                     const std::vector<openvdb::Vec3f>& points) {
+                                     const std::vector<openvdb::Vec3f>& points, int rounds) {
     if (voxels.size() != points.size()) throw std::invalid_argument("nearestSeeds: as many voxels as points");
+    if (rounds < 0) throw std::invalid_argument("nearestSeeds: a negative count of rounds");
     if (voxels.size() >= std::size_t(std::numeric_limits<std::int32_t>::max()))
         throw std::length_error("nearestSeeds: too many seeds");
     auto ids = std::make_shared<openvdb::Int32Tree>(region, kUnreached, openvdb::TopologyCopy());
@@ -131,13 +132,15 @@ openvdb::Int32Tree::Ptr nearestSeeds(const openvdb::MaskTree& region, const std:
     // result does not depend on the order), then those that changed written. Reached voxels are
     // taken up again because the rounds are layers of 26-neighbour steps, not of distance: a
     // voxel first reached from one seed may be nearer to another that arrives a round later.
-    // Every change brings a voxel nearer to its seed, so the rounds end.
+    // Every change brings a voxel nearer to its seed, so the rounds end; `rounds` ends them
+    // sooner. Each round's outcome depends only on the voxels' and their neighbours' values before
+    // it (claims only mark; the choice reads, then writes), never on the order of the work.
     ThreadScratch<std::vector<std::uint64_t>> claims;
     std::vector<std::int32_t> chosen;
     auto squared = [&](const openvdb::Vec3f& at, std::int32_t seed) {
         return (at - points[std::size_t(seed)]).lengthSqr();
     };
-    while (!layer.empty()) {
+    for (int round = 0; round < rounds && !layer.empty(); ++round) {
         tbb::parallel_for(
             tbb::blocked_range<std::size_t>(0, layer.size(), 1024), [&](const tbb::blocked_range<std::size_t>& range) {
                 std::vector<std::uint64_t>& claimed = claims.local();

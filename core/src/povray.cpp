@@ -410,7 +410,10 @@ DensityGrid bakeDensityGrid(const Params& params, int resolution, const Progress
     return grid;
 }
 
-void writeDf3(const DensityGrid& grid, const std::string& path, int bits, Existing existing) {
+namespace {
+
+/// The DF3 file's bytes into `file` (see writeDf3).
+void writeDf3To(const DensityGrid& grid, AtomicFile& file, int bits) {
     if (bits != 8 && bits != 16 && bits != 32)
         throw std::invalid_argument("DF3 samples are 8, 16 or 32 bits, got " + std::to_string(bits));
     if (grid.resolution < 1 || grid.resolution > 65535 ||
@@ -429,8 +432,14 @@ void writeDf3(const DensityGrid& grid, const std::string& path, int bits, Existi
         const auto code = static_cast<std::uint32_t>(std::lround(clamped * maximum));
         for (int byte = bytes - 1; byte >= 0; --byte) data.push_back(static_cast<unsigned char>(code >> (8 * byte)));
     }
-    AtomicFile file(path, existing);
     file.stream().write(reinterpret_cast<const char*>(data.data()), static_cast<std::streamsize>(data.size()));
+}
+
+}  // namespace
+
+void writeDf3(const DensityGrid& grid, const std::string& path, int bits, Existing existing) {
+    AtomicFile file(path, existing);
+    writeDf3To(grid, file, bits);
     file.commit();
 }
 
@@ -484,26 +493,21 @@ std::vector<std::string> writePovray(const Params& params, const std::string& sc
         df3SceneText = povrayScene(params, df3Options);
     }
 
-    std::vector<std::string> written;
-    auto writeFile = [&](const std::string& path, const std::string& text) {
-        AtomicFile file(path, options.existing);
-        file.stream() << text;
-        file.commit();
-        written.push_back(path);
-    };
-    if (!files.scene.empty()) writeFile(files.scene, sceneText);
+    // Every file written before the first gets its name: all of them or none (AtomicFileSet).
+    AtomicFileSet set(options.existing);
+    if (!files.scene.empty()) set.add(files.scene).stream() << sceneText;
     if (options.df3) {
-        writeDf3(grid, files.df3, options.df3Bits, options.existing);
-        written.push_back(files.df3);
-        writeFile(files.df3Scene, df3SceneText);
+        writeDf3To(grid, set.add(files.df3), options.df3Bits);
+        set.add(files.df3Scene).stream() << df3SceneText;
     }
     if (!files.include.empty()) {
         std::ifstream existing(pathFromUtf8(files.include), std::ios::binary);
         std::ostringstream current;
         current << existing.rdbuf();
-        if (!existing || current.str() != povrayInclude()) writeFile(files.include, std::string(povrayInclude()));
+        if (!existing || current.str() != povrayInclude()) set.add(files.include).stream() << povrayInclude();
     }
-    return written;
+    set.commit();
+    return set.paths();
 }
 
 }  // namespace dqj

@@ -13,6 +13,7 @@
 #include <openvdb/tools/Prune.h>
 
 #include "atomic_file.hpp"
+#include "attribute_reach.hpp"
 #include "dqjulia/version.h"
 #include "file_names.hpp"
 #include "level_set.hpp"
@@ -187,14 +188,36 @@ std::string tilePath(const std::string& path, int index) {
 }
 
 int tileHalo(const BakeSettings& bake) {
-    // The rebuilt distance near a cut face depends on the surface a few voxels beyond the band
-    // (at least 5, 6, 7 voxels for band widths 1, 3, 6): leaves of 8, two for wider bands.
+    // The level set: the rebuilt distance near a cut face depends on the surface a few voxels
+    // beyond the band (at least 5, 6, 7 voxels for band widths 1, 3, 6): leaves of 8, two for
+    // wider bands. So the tile's level set (its band's values and active states, the inside's
+    // signs) is the whole bake's at every voxel at least this far inside the tile's window.
     const int band = int(std::ceil(bake.bandWidth));
-    int halo = 8 * ((band + 5 + 7) / 8);
-    // The attribute grids reach below the band to the colour depth, following the surface there.
-    if (hasGrid(bake, BakeGrid::Color) || hasGrid(bake, BakeGrid::Trap) || hasGrid(bake, BakeGrid::Iterations))
-        halo += std::max(0, int(std::ceil(bake.colorDepth * bake.resolution)) - band);
-    return halo;
+    const int levelSet = 8 * ((band + 5 + 7) / 8);
+    if (!hasGrid(bake, BakeGrid::Color) && !hasGrid(bake, BakeGrid::Trap) && !hasGrid(bake, BakeGrid::Iterations))
+        return levelSet;
+    // The attribute grids (bake.cpp, addAttributeGrids) are the whole bake's on the kept box K:
+    // - Their region and seeds are made from the level set alone, each voxel's from a few
+    //   around it: a voxel is in the region if it is in the band, or inside and within
+    //   attributeDilation() 26-neighbour steps of the band; it is a seed if it and a face
+    //   neighbour lie on either side of the surface, its point and its values (the orbit
+    //   there) taken from it and its 6 face neighbours. So both are the whole bake's wherever
+    //   the level set is, within max(dilation, 1) steps: up to levelSet + max(dilation, 1)
+    //   voxels inside the window.
+    // - nearestSeeds runs at most attributeRounds() rounds, and after r rounds a voxel's seed
+    //   depends on the region and the seeds within r steps of it alone (nearest_seed.hpp), ties
+    //   going to the lower seed index. Both bakes number the seeds in the level set tree's
+    //   order of their voxels (leaf by leaf, each leaf's in offset order), a fixed order of
+    //   coordinates, so any two seeds they share compare alike.
+    // So a halo of levelSet + rounds + max(dilation, 1) gives every voxel of K the whole bake's
+    // seed, ties included, hence its colour, trap and iteration count. Nothing in this uses the
+    // resolution, the tiling or where the tile lies (on the whole bake's outer faces the window
+    // is cut where the whole is), only the band and the colour depth in voxels, which the halo
+    // follows: it holds at any size. (Before, the halo added only the dilation and the seeds
+    // spread until nothing changed, so nothing bounded how far a seed travels: at 512^3 a few
+    // seam voxels took seeds from near the tile's cut face, where the tile's level set, and so
+    // its seeds, are not the whole bake's. tiles_test.cpp, seam512, holds that case.)
+    return levelSet + attributeRounds(bake) + std::max(attributeDilation(bake), 1);
 }
 
 void checkTile(const Params& params, const Tile& tile) {

@@ -1,11 +1,13 @@
 // nearestSeeds (core/src/nearest_seed.hpp, internal): against the brute-force nearest seed, on a
-// box (convex: every seed's nearest voxels are reachable) and on two pieces, one without seeds.
+// box (convex: every seed's nearest voxels are reachable) and on two pieces, one without seeds;
+// with its rounds bounded, a voxel's seed depends on nothing further than that many steps.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <random>
+#include <stdexcept>
 
 #include <openvdb/openvdb.h>
 
@@ -136,6 +138,134 @@ TEST(NearestSeeds, OfTwoSeedsOnOneVoxelTheFirstIsKept) {
     const openvdb::Int32Tree::Ptr ids = dqj::nearestSeeds(region, voxels, points);
     EXPECT_EQ(ids->activeVoxelCount(), 512u);
     for (auto on = ids->cbeginValueOn(); on; ++on) EXPECT_EQ(*on, 0);
+}
+
+/// A region of [0, size)^3 with about one voxel in `holes` missing, and `count` seeds in it, half
+/// of them at their voxels' centres (so that some voxels lie equally near two seeds).
+struct Input {
+    openvdb::MaskTree region;
+    std::vector<Coord> voxels;
+    std::vector<Vec3f> points;
+};
+
+Input randomInput(int size, int holes, int count, unsigned seed) {
+    std::mt19937 random(seed);
+    Input input{box(Coord(0), Coord(size - 1)), {}, {}};
+    std::uniform_int_distribution<int> at(0, size - 1);
+    for (int hole = 0; hole < size * size * size / holes; ++hole)
+        input.region.setValueOff(Coord(at(random), at(random), at(random)));
+    std::uniform_real_distribution<float> off(-0.5f, 0.5f);
+    for (int index = 0; index < count; ++index) {
+        const Coord voxel(at(random), at(random), at(random));
+        const bool centre = index % 2 == 0;
+        input.voxels.push_back(voxel);
+        input.points.push_back(voxel.asVec3s() + (centre ? Vec3f(0.0f) : Vec3f(off(random), off(random), off(random))));
+    }
+    return input;
+}
+
+/// The seeds sorted by voxel (x, then y, then z), the first of a voxel kept: the order the bake
+/// numbers its seeds in is one fixed order of their voxels too.
+void sortByVoxel(Input& input) {
+    std::vector<std::size_t> order(input.voxels.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = k;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return input.voxels[a] < input.voxels[b]; });
+    std::vector<Coord> voxels;
+    std::vector<Vec3f> points;
+    for (const std::size_t k : order) {
+        if (!voxels.empty() && voxels.back() == input.voxels[k]) continue;
+        voxels.push_back(input.voxels[k]);
+        points.push_back(input.points[k]);
+    }
+    input.voxels = std::move(voxels);
+    input.points = std::move(points);
+}
+
+/// `inner` as `outer` has it within `box` and as it has it elsewhere: the region's voxels and
+/// the seeds on them.
+Input agreeWithin(const Input& inner, const Input& outer, const openvdb::CoordBBox& box) {
+    Input result{outer.region, {}, {}};
+    for (auto ijk = box.begin(); ijk; ++ijk) result.region.setValueOff(*ijk);
+    for (auto ijk = box.begin(); ijk; ++ijk)
+        if (inner.region.isValueOn(*ijk)) result.region.setValueOn(*ijk);
+    for (const Input* from : {&inner, &outer})
+        for (std::size_t k = 0; k < from->voxels.size(); ++k)
+            if (box.isInside(from->voxels[k]) == (from == &inner)) {
+                result.voxels.push_back(from->voxels[k]);
+                result.points.push_back(from->points[k]);
+            }
+    sortByVoxel(result);
+    return result;
+}
+
+TEST(NearestSeeds, AfterRRoundsAVoxelsSeedDependsOnNothingFurtherThanRSteps) {
+    // What makes tiled bakes exact (tileHalo, tiles.cpp): two inputs that agree within R steps
+    // of a box and differ everywhere beyond it (the region's holes, seeds missing, moved and
+    // added, many equally near two seeds) give every voxel of the box the same seed, ties
+    // included, after R rounds; one step less of agreement, or rounds without a bound, and they
+    // do not.
+    const int size = 40, rounds = 7;
+    const openvdb::CoordBBox compared(Coord(15), Coord(24));
+    openvdb::CoordBBox agreed = compared;
+    agreed.expand(rounds);
+    int differingWithoutBound = 0, differingTooClose = 0;
+    std::size_t voxels = 0, ties = 0;
+    for (unsigned trial = 0; trial < 6; ++trial) {
+        Input a = randomInput(size, 6, 120, 2 * trial + 1);
+        sortByVoxel(a);
+        const Input other = randomInput(size, 4, 400, 2 * trial + 2);
+        const Input b = agreeWithin(a, other, agreed);
+        auto seedVoxel = [](const openvdb::Int32Tree& ids, const Input& input, const Coord& ijk) {
+            const int id = ids.getValue(ijk);
+            return ids.isValueOn(ijk) ? input.voxels[std::size_t(id)] : Coord(-1);
+        };
+        auto differing = [&](const openvdb::Int32Tree& x, const Input& xi, const openvdb::Int32Tree& y,
+                             const Input& yi) {
+            int count = 0;
+            for (auto ijk = compared.begin(); ijk; ++ijk) count += seedVoxel(x, xi, *ijk) != seedVoxel(y, yi, *ijk);
+            return count;
+        };
+        const auto idsA = dqj::nearestSeeds(a.region, a.voxels, a.points, rounds);
+        const auto idsB = dqj::nearestSeeds(b.region, b.voxels, b.points, rounds);
+        EXPECT_EQ(differing(*idsA, a, *idsB, b), 0) << "trial " << trial;
+        for (auto ijk = compared.begin(); ijk; ++ijk) {
+            if (!idsA->isValueOn(*ijk)) continue;
+            ++voxels;
+            const Vec3f at = (*ijk).asVec3s();
+            const float taken = (at - a.points[std::size_t(idsA->getValue(*ijk))]).lengthSqr();
+            for (std::size_t k = 0; k < a.points.size(); ++k)
+                if (std::int32_t(k) != idsA->getValue(*ijk) && (at - a.points[k]).lengthSqr() == taken) {
+                    ++ties;
+                    break;
+                }
+        }
+        differingWithoutBound += differing(*dqj::nearestSeeds(a.region, a.voxels, a.points), a,
+                                           *dqj::nearestSeeds(b.region, b.voxels, b.points), b);
+        openvdb::CoordBBox closer = compared;
+        closer.expand(rounds - 1);
+        const Input c = agreeWithin(a, other, closer);
+        differingTooClose += differing(*idsA, a, *dqj::nearestSeeds(c.region, c.voxels, c.points, rounds), c);
+    }
+    std::printf(
+        "%zu voxels alike after %d rounds (%zu of them as near to another seed); without a bound %d "
+        "differ, with one step less agreed %d\n",
+        voxels, rounds, ties, differingWithoutBound, differingTooClose);
+    EXPECT_GT(voxels, 4000u);
+    EXPECT_GT(ties, 10u);
+    EXPECT_GT(differingWithoutBound, 0);
+    EXPECT_GT(differingTooClose, 0);
+}
+
+TEST(NearestSeeds, ZeroRoundsLeaveTheSeedsVoxelsAlone) {
+    const openvdb::MaskTree region = box(Coord(0), Coord(7));
+    const std::vector<Coord> voxels{Coord(1), Coord(6)};
+    const std::vector<Vec3f> points{Vec3f(1.0f), Vec3f(6.0f)};
+    const openvdb::Int32Tree::Ptr ids = dqj::nearestSeeds(region, voxels, points, 0);
+    EXPECT_EQ(ids->activeVoxelCount(), 2u);
+    EXPECT_EQ(ids->getValue(Coord(6)), 1);
+    EXPECT_EQ(dqj::nearestSeeds(region, voxels, points, 1)->activeVoxelCount(), 2u * 27u);
+    EXPECT_THROW(dqj::nearestSeeds(region, voxels, points, -1), std::invalid_argument);
 }
 
 }  // namespace

@@ -1,147 +1,33 @@
-// Tiled bakes (tiles.hpp): tiles merged equal the one-piece bake voxel for voxel (every grid,
-// values bit for bit, active states, the inside and outside beyond the band), on leaf-aligned
-// and unaligned tilings and for band widths 1, 3 and 6; each tile keeps only its box; the merge
-// refuses tiles that do not belong together or do not cover the box once.
+// Tiled bakes (tiles.hpp): tiles merged equal the one-piece bake voxel for voxel (every grid a
+// bake can hold: surface, density, color, trap, iterations; values bit for bit, active states,
+// the inside and outside beyond the band), on leaf-aligned and unaligned tilings, for band
+// widths 1, 3 and 6, colour depths from the band to 12 voxels below it, and a crop of the
+// 512^3 bake across its seam, where a too small halo showed first (tiles_long_test.cpp: whole
+// bakes of 384^3 to 576^3, crops of 1024^3 and 2048^3); each tile keeps only its box; the
+// merge refuses tiles that do not belong together or do not cover the box once.
 #include <gtest/gtest.h>
 
-#include <algorithm>
-#include <bit>
-#include <cstdint>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
-#include <map>
+#include <string>
+#include <vector>
 
-#include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 
 #include "dqjulia/bake.hpp"
 #include "dqjulia/params.hpp"
 #include "dqjulia/tiles.hpp"
 #include "dqjulia/version.h"
-#include "test_support.hpp"
+#include "tile_merge_check.hpp"
 
 namespace fs = std::filesystem;
 using namespace dqj;
+using dqj::test::readVdb;
+using dqj::test::Tiles;
+using dqj::test::VdbFile;
 
 namespace {
-
-class Tiles : public ::testing::Test {
-protected:
-    static void SetUpTestSuite() { openvdb::initialize(); }
-    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_tiles"); }
-    void TearDown() override { fs::remove_all(dir_); }
-    std::string path(const std::string& name) const { return (dir_ / name).string(); }
-
-    /// Bakes every tile of `tiling` beside "whole.vdb" and returns their paths.
-    std::vector<std::string> bakeTiles(const Params& params, const std::string& tiling) {
-        Tile tile = parseTiling(tiling);
-        std::vector<std::string> paths;
-        for (tile.index = 1; tile.index <= tileCount(tile); ++tile.index) {
-            BakeOptions options;
-            options.tile = tile;
-            paths.push_back(tilePath(path("whole.vdb"), tile.index));
-            bakeVdb(params, paths.back(), options);
-        }
-        return paths;
-    }
-    fs::path dir_;
-};
-
-struct VdbFile {
-    std::map<std::string, openvdb::GridBase::Ptr> grids;
-    openvdb::MetaMap::Ptr metadata;
-};
-
-VdbFile readVdb(const std::string& path) {
-    openvdb::io::File file(path);
-    file.open();
-    VdbFile result;
-    const openvdb::GridPtrVecPtr grids = file.getGrids();
-    for (const openvdb::GridBase::Ptr& grid : *grids) result.grids[grid->getName()] = grid;
-    result.metadata = file.getMetadata();
-    file.close();
-    return result;
-}
-
-/// Voxels compared and those that differ (value bits or active state) between two grids of
-/// one type, over the bounding box of both grids' active voxels grown by 2 voxels.
-struct Comparison {
-    std::uint64_t voxels = 0;
-    std::uint64_t differences = 0;
-    std::uint64_t active = 0;
-    std::uint64_t stateDiffers = 0;  // active in one grid only
-    double largest = 0.0;            // the largest value difference where both are active
-};
-
-double distance(float u, float v) { return std::abs(double(u) - double(v)); }
-double distance(const openvdb::Vec3s& u, const openvdb::Vec3s& v) { return double((u - v).length()); }
-/// Bit for bit, so that -0 and 0 (or two NaNs) are told apart.
-bool sameBits(float a, float b) { return std::bit_cast<std::uint32_t>(a) == std::bit_cast<std::uint32_t>(b); }
-bool sameBits(const openvdb::Vec3s& a, const openvdb::Vec3s& b) {
-    return sameBits(a.x(), b.x()) && sameBits(a.y(), b.y()) && sameBits(a.z(), b.z());
-}
-
-template <typename GridT>
-Comparison compareGrids(const GridT& a, const GridT& b) {
-    openvdb::CoordBBox box = a.evalActiveVoxelBoundingBox();
-    box.expand(b.evalActiveVoxelBoundingBox());
-    box.expand(2);
-    auto x = a.getConstAccessor();
-    auto y = b.getConstAccessor();
-    Comparison result;
-    for (auto ijk = box.begin(); ijk; ++ijk) {
-        const auto u = x.getValue(*ijk), v = y.getValue(*ijk);
-        const bool on = x.isValueOn(*ijk);
-        ++result.voxels;
-        result.active += on;
-        if (on != y.isValueOn(*ijk) || !sameBits(u, v)) {
-            ++result.differences;
-            if (on != y.isValueOn(*ijk))
-                ++result.stateDiffers;
-            else
-                result.largest = std::max(result.largest, distance(u, v));
-        }
-    }
-    return result;
-}
-
-/// Every grid of the one-piece file against the merged file's; both hold the same grids and
-/// the same file metadata.
-Comparison compareFiles(const std::string& whole, const std::string& merged) {
-    const VdbFile a = readVdb(whole), b = readVdb(merged);
-    Comparison total;
-    EXPECT_EQ(a.grids.size(), b.grids.size());
-    for (const auto& [name, grid] : a.grids) {
-        const auto other = b.grids.find(name);
-        if (other == b.grids.end()) {
-            ADD_FAILURE() << "the merged file has no grid " << name;
-            continue;
-        }
-        EXPECT_EQ(grid->transform(), other->second->transform()) << name;
-        EXPECT_EQ(grid->getGridClass(), other->second->getGridClass()) << name;
-        Comparison one;
-        if (auto vectors = openvdb::gridPtrCast<openvdb::Vec3SGrid>(grid))
-            one = compareGrids(*vectors, *openvdb::gridPtrCast<openvdb::Vec3SGrid>(other->second));
-        else
-            one = compareGrids(*openvdb::gridPtrCast<openvdb::FloatGrid>(grid),
-                               *openvdb::gridPtrCast<openvdb::FloatGrid>(other->second));
-        // Every grid the one-piece bake's exactly; the attribute grids too, since each voxel's
-        // nearest seed (nearest_seed.hpp) is within the tile's halo (the fast sweeps they were
-        // made by before depended a little on the swept domain near a tile's edge).
-        EXPECT_EQ(one.stateDiffers, 0u) << name;
-        EXPECT_EQ(one.differences, 0u) << name << ": " << one.differences << " of " << one.voxels
-                                       << " voxels differ, by at most " << one.largest;
-        EXPECT_GT(one.active, 100u) << name;
-        total.voxels += one.voxels;
-        total.differences += one.differences;
-        total.active += one.active;
-    }
-    for (const char* key : {"creator", "dqjulia_parameters"})
-        EXPECT_EQ(a.metadata->metaValue<std::string>(key), b.metadata->metaValue<std::string>(key)) << key;
-    EXPECT_EQ(a.metadata->metaValue<double>("dqjulia_voxel_size"), b.metadata->metaValue<double>("dqjulia_voxel_size"));
-    EXPECT_FALSE((*b.metadata)["dqjulia_tiling"]);
-    return total;
-}
 
 struct Case {
     const char* name;
@@ -149,7 +35,8 @@ struct Case {
     double band;
     const char* tiling;
     bool dual;
-    bool attributes;  // the colour and trap grids too, reaching below the band
+    double colorDepth;  // 0: no attribute grids; else color, trap and iterations too, this deep
+    int crop = 0;       // else a 128^3 crop of the default bake at crop^3 (voxel size, seam, depth)
 };
 
 class TilesMerge : public Tiles, public ::testing::WithParamInterface<Case> {};
@@ -160,35 +47,36 @@ TEST_P(TilesMerge, EqualTheOnePieceBakeVoxelForVoxel) {
     params.bake.resolution = c.resolution;
     params.bake.bandWidth = c.band;
     params.bake.grids = {BakeGrid::Surface, BakeGrid::Density};
-    if (c.attributes) {
-        params.bake.grids.insert(params.bake.grids.end(), {BakeGrid::Color, BakeGrid::Trap});
-        params.bake.colorDepth = 0.1;  // 7 voxels below the band: the halo grows for them
+    if (c.colorDepth > 0.0) {
+        params.bake.grids.insert(params.bake.grids.end(), {BakeGrid::Color, BakeGrid::Trap, BakeGrid::Iterations});
+        params.bake.colorDepth = c.colorDepth;
     }
+    if (c.crop) dqj::test::cropOf(params, c.crop, openvdb::Coord(128));
     if (c.dual) {
         params.fractal.variant = Variant::Dual;
         params.fractal.c = toDualQuat({-0.2, 0.6, 0.2, 0.0, 0.0, 0.0, 0.0, 0.0});
         params.fractal.iterations = 12;
     }
-    const BakeStats whole = bakeVdb(params, path("whole.vdb"));
-    const std::vector<std::string> tiles = bakeTiles(params, c.tiling);
-    const MergeStats merged = mergeTiles(tiles, path("merged.vdb"));
-    EXPECT_EQ(merged.tiles, tileCount(parseTiling(c.tiling)));
-    EXPECT_EQ(merged.activeVoxels, whole.activeVoxels);
-    const Comparison comparison = compareFiles(path("whole.vdb"), path("merged.vdb"));
-    EXPECT_EQ(comparison.differences, 0u);
-    std::printf("[ figures  ] %s: %s tiles of %d^3, band %g: %llu voxels compared (%llu active), %llu differ\n", c.name,
-                c.tiling, c.resolution, c.band, static_cast<unsigned long long>(comparison.voxels),
-                static_cast<unsigned long long>(comparison.active),
-                static_cast<unsigned long long>(comparison.differences));
+    dqj::test::checkMergeEqualsWhole(*this, params, c.tiling, c.name);
 }
 
 // The default bake's index box at 64^3 is 69 voxels a side from -34: halves split at 0 (on a
 // leaf boundary), thirds at -11 and 12 (not); at 128^3, 133 voxels from -66, thirds at -22, 22.
+// Colour depths (voxels; the region reaches as many 26-neighbour steps below the band, sqrt 3
+// times as deep along the diagonals) and halos (tileHalo: level set + the seeds' rounds + that
+// reach): 0.05 at 64^3 is 4 (halo 25), 0.08 at 160^3 with band 1 13 (54), 0.06 at 160^3 with
+// band 6 10 (48), 0.05 at 128^3 7 (34) and at 200^3 10 (43); seam512 is a crop of the 512^3 bake
+// across its 2x1x1 seam, where the colour first differed (11 voxels, halo 46; the 1024^3 crops
+// and the whole 512^3 bake are in tiles_long_test.cpp). Each tile's window ends inside the box.
 INSTANTIATE_TEST_SUITE_P(
     Tilings, TilesMerge,
-    ::testing::Values(Case{"aligned", 64, 3.0, "2x2x2", false, true}, Case{"unaligned", 64, 3.0, "3x2x1", false, true},
-                      Case{"band1", 64, 1.0, "3x1x1", false, false}, Case{"band6", 64, 6.0, "1x3x1", false, false},
-                      Case{"dual", 64, 3.0, "1x1x3", true, false}, Case{"r128", 128, 3.0, "3x1x1", false, false}),
+    ::testing::Values(Case{"aligned", 64, 3.0, "2x2x2", false, 0.05}, Case{"unaligned", 64, 3.0, "3x2x1", false, 0.05},
+                      Case{"band1", 64, 1.0, "3x1x1", false, 0.0}, Case{"band6", 64, 6.0, "1x3x1", false, 0.0},
+                      Case{"dual", 64, 3.0, "1x1x3", true, 0.0}, Case{"r128", 128, 3.0, "3x1x1", false, 0.0},
+                      Case{"deepBand1", 160, 1.0, "2x2x1", false, 0.08},
+                      Case{"deepBand6", 160, 6.0, "3x1x1", false, 0.06},
+                      Case{"deepDual", 128, 3.0, "1x2x2", true, 0.05}, Case{"r200", 200, 3.0, "1x1x2", false, 0.05},
+                      Case{"seam512", 128, 3.0, "2x1x1", false, 0.02, 512}),
     [](const auto& info) { return std::string(info.param.name); });
 
 TEST_F(Tiles, EachTileKeepsOnlyItsBoxAndSaysWhichItIs) {

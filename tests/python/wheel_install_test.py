@@ -57,11 +57,30 @@ def interrupt_after(command, seconds, ready=None, **options):
         text=True,
         **options,
     )
-    first = process.stdout.readline() if ready is not None else ""
+    first = process.stdout.readline() if ready is not None else wait_for_sigint_handler(process.pid, command[0])
     time.sleep(seconds)
     process.send_signal(signal.SIGINT)
     stdout, stderr = process.communicate(timeout=300)
     return process.returncode, first + stdout, stderr
+
+
+def wait_for_sigint_handler(pid, command):
+    """Waits until the process runs the native program named like `command` (after any exec of
+    Python scripts on the way) and that program has installed its SIGINT handler, so a loaded
+    machine's slow start cannot turn the test's Ctrl-C into SIGINT's default action; returns ""."""
+    name = os.path.basename(command)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline:
+        try:
+            exe = os.path.basename(os.readlink("/proc/%d/exe" % pid))
+            with open("/proc/%d/status" % pid) as status:
+                caught = next(int(line.split()[1], 16) for line in status if line.startswith("SigCgt:"))
+        except (OSError, StopIteration):
+            return ""  # gone already: the caller sees its exit status
+        if exe == name and caught & (1 << (signal.SIGINT - 1)):
+            return ""
+        time.sleep(0.02)
+    return ""
 
 
 def files_equal(first, second):

@@ -103,9 +103,10 @@ def check_wheel(path, source, version, platform, epoch=None):
     if epoch is not None:
         import time
 
-        stamp = time.gmtime(max(epoch, 315532800))[:6]
-        stamp = stamp[:5] + (stamp[5] // 2 * 2,)  # a zip entry's time has 2-second steps
-        checks["every entry's time is SOURCE_DATE_EPOCH %d" % epoch] = all(
+        # A zip entry's time has a resolution of two seconds (MS-DOS time): an odd second is stored
+        # as the even one before it.
+        stamp = time.gmtime(max(epoch, 315532800) // 2 * 2)[:6]
+        checks["every entry's time is SOURCE_DATE_EPOCH %d (to the zip's 2 s)" % epoch] = all(
             entry.date_time == stamp for entry in entries
         )
     return checks

@@ -1,7 +1,8 @@
 /* fault_shim.c - an LD_PRELOAD library that makes writes into one folder fail, for the
- * fault-injection tests (hostile_input_test.cpp).
+ * fault-injection tests (hostile_input_test.cpp, outputs_test.cpp).
  *
- * It replaces glibc's write, fsync and close, so it works whatever the program links
+ * It replaces glibc's write, fsync and close (and, for mode publish, rename, renameat2, link and
+ * linkat), so it works whatever the program links
  * statically (OpenVDB, TBB, libpng) as long as glibc itself is a shared library. Only
  * descriptors whose file lies in DQJ_FAULT_DIR are touched (an O_TMPFILE shows up there as
  * "DIR/#123 (deleted)"); everything else passes through. Settings, from the environment:
@@ -9,8 +10,11 @@
  *   DQJ_FAULT_MODE   enospc: writes fail with ENOSPC once DQJ_FAULT_AFTER bytes were written;
  *                    short:  every write there writes at most half its bytes (at least 1), and
  *                            fails with ENOSPC after DQJ_FAULT_AFTER bytes;
- *                    fsync:  fsync fails with EIO;  close: close fails with EIO.
- *   DQJ_FAULT_AFTER  bytes allowed before writes fail (default 0)
+ *                    fsync:  fsync fails with EIO;  close: close fails with EIO;
+ *                    publish: giving a file its name there fails with EIO (rename, renameat2,
+ *                            link, linkat onto a name that is not hidden, i.e. does not start
+ *                            with '.'), once, after DQJ_FAULT_AFTER such names were given.
+ *   DQJ_FAULT_AFTER  bytes allowed before writes fail, or names given before one fails (default 0)
  *   DQJ_FAULT_NO_TMPFILE=1  open(O_TMPFILE) fails with EOPNOTSUPP, as on a file system
  *                    without it, so the writer's fallback (a hidden, locked name) is tested
  */
@@ -106,4 +110,60 @@ int close(int fd) {
         return -1;
     }
     return real_close(fd);
+}
+
+/* Whether giving `path` its name is the one that fails (mode publish): a visible name in the fault
+ * folder, after DQJ_FAULT_AFTER others. Only that one fails, so putting files back still works. */
+static long long names_given;
+
+static int publish_fails(const char* path) {
+    const char* dir = getenv("DQJ_FAULT_DIR");
+    if (!mode_is("publish") || !dir || !*dir || !path) return 0;
+    const size_t dirLength = strlen(dir);
+    if (strncmp(path, dir, dirLength) != 0 || path[dirLength] != '/') return 0;
+    const char* name = strrchr(path, '/') + 1;
+    if (name[0] == '.') return 0;
+    const char* after = getenv("DQJ_FAULT_AFTER");
+    return names_given++ == (after ? atoll(after) : 0);
+}
+
+int rename(const char* from, const char* to) {
+    static int (*real_rename)(const char*, const char*);
+    if (!real_rename) real_rename = (int (*)(const char*, const char*))dlsym(RTLD_NEXT, "rename");
+    if (publish_fails(to)) {
+        errno = EIO;
+        return -1;
+    }
+    return real_rename(from, to);
+}
+
+int renameat2(int fromDir, const char* from, int toDir, const char* to, unsigned int flags) {
+    static int (*real_renameat2)(int, const char*, int, const char*, unsigned int);
+    if (!real_renameat2)
+        real_renameat2 = (int (*)(int, const char*, int, const char*, unsigned int))dlsym(RTLD_NEXT, "renameat2");
+    if (publish_fails(to)) {
+        errno = EIO;
+        return -1;
+    }
+    return real_renameat2(fromDir, from, toDir, to, flags);
+}
+
+int link(const char* from, const char* to) {
+    static int (*real_link)(const char*, const char*);
+    if (!real_link) real_link = (int (*)(const char*, const char*))dlsym(RTLD_NEXT, "link");
+    if (publish_fails(to)) {
+        errno = EIO;
+        return -1;
+    }
+    return real_link(from, to);
+}
+
+int linkat(int fromDir, const char* from, int toDir, const char* to, int flags) {
+    static int (*real_linkat)(int, const char*, int, const char*, int);
+    if (!real_linkat) real_linkat = (int (*)(int, const char*, int, const char*, int))dlsym(RTLD_NEXT, "linkat");
+    if (publish_fails(to)) {
+        errno = EIO;
+        return -1;
+    }
+    return real_linkat(fromDir, from, toDir, to, flags);
 }

@@ -2,7 +2,9 @@
 default picture, a bake and a mesh, each compared with the Linux one by the Linux build's
 compare_outputs (its PNG reader, the Linux OpenVDB); every output named with a drive letter and
 backslashes, in a folder with spaces and letters beyond ASCII; an existing output kept without
---force and replaced with it; no temporary file left behind.
+--force and replaced with it; no temporary file left behind; names Windows cannot hold (CON, NUL,
+COM1, a trailing dot, a stream) refused before the work; an input never an output; a multi-file
+run replaced all together.
 
 Usage: python3 cli_test.py WORK LINUX_BUILD DQJULIA_EXE EMULATOR...
 """
@@ -76,7 +78,88 @@ def main():
     checks["the folder holds the outputs and nothing else (no temporary file): %s" % names] = names == sorted(
         name for name, _, _ in OUTPUTS
     )
+    checks.update(check_outputs(work, exe, emulator))
     return report(checks)
+
+
+# Names Windows cannot hold, as a file or as a folder on the way: each refused before the work.
+IMPOSSIBLE = (
+    ("CON.png", "reserves for a device"),
+    ("nul", "reserves for a device"),
+    ("Aux.tar.png", "reserves for a device"),
+    ("com1.png", "reserves for a device"),
+    ("LPT9.png", "reserves for a device"),
+    ("CONOUT$.png", "reserves for a device"),
+    ("NUL .png", "reserves for a device"),
+    ("PRN\\picture.png", "reserves for a device"),
+    ("picture.png.", "which Windows removes"),
+    ("picture.png ", "which Windows removes"),
+    ("picture.png:stream", "a colon names a data stream"),
+)
+
+
+def check_outputs(work, exe, emulator):
+    """The rules for outputs on Windows: impossible names refused before any work (exit 2, nothing
+    written), an input never an output (file identity, whatever the spelling), and a run's files
+    replaced all together."""
+    checks = {}
+    folder = os.path.join(work, "outputs")
+    os.makedirs(folder)
+    here = windows_path(folder)
+    for name, reason in IMPOSSIBLE:
+        # A render of 1600x1200 takes many seconds under Wine: a refusal after it would show. The
+        # format is given, so that names not ending in .png meet the Windows rule, not the extension's.
+        render = ["render", "-q", "-W", "1600", "-H", "1200", "--format", "png8"]
+        status, output = run([*emulator, exe, *render, "-o", here + "\\" + name])
+        checks["%r refused before the work: exit %d %s" % (name, status, output.strip())] = (
+            status == 2 and reason in output and not os.listdir(folder)
+        )
+    # The other writers, a reserved name in a folder of the path or in a second output.
+    for arguments in (
+        ["bake", "-q", "-r", "1024", "-o", here + "\\com3\\fractal.vdb"],
+        ["mesh", "-q", "-r", "1024", "-o", here + "\\Nul.x\\fractal.ply"],
+        ["explore", "-q", "--count", "100", "-o", here + "\\lpt1"],
+        ["povray", "-q", "--df3", "--df3-resolution", "512", "-o", here + "\\CON\\scene.pov"],
+        ["render", "-q", "-W", "1600", "-H", "1200", "-o", here + "\\ok.png", "--save-params", here + "\\aux.json"],
+    ):
+        status, output = run([*emulator, exe, *arguments])
+        checks["%s %s refused before the work: exit %d %s" % (arguments[0], arguments[-1], status, output.strip())] = (
+            status == 2 and "reserves for a device" in output and not os.listdir(folder)
+        )
+    params = os.path.join(folder, "p.json")
+    with open(params, "w") as file:
+        file.write('{"fractal": {"iterations": 8}}\n')
+    status, output = run(
+        [
+            *emulator,
+            exe,
+            "render",
+            "-q",
+            "-W",
+            "8",
+            "-H",
+            "8",
+            "-p",
+            here + "\\p.json",
+            "-o",
+            here + "\\p.png",
+            "--save-params",
+            here + "\\P.JSON",
+            "--force",
+        ]
+    )
+    checks["--save-params onto --params (spelt P.JSON) refused: exit %d %s" % (status, output.strip())] = (
+        status == 2 and "which this run reads" in output and sorted(os.listdir(folder)) == ["p.json"]
+    )
+    # A POV-Ray scene with its grid and include, written and then replaced all together (--force).
+    scene = ["povray", "-q", "--df3", "--df3-resolution", "8", "-o", here + "\\scene.pov"]
+    for attempt, extra in (("written", []), ("replaced", ["--force"])):
+        status, output = run([*emulator, exe, *scene, *extra])
+        names = sorted(os.listdir(folder))
+        checks["povray --df3 %s: exit %d %s; files %s" % (attempt, status, output.strip(), names)] = status == 0 and (
+            names == ["dqjulia.inc", "p.json", "scene.df3", "scene.pov", "scene_df3.pov"]
+        )
+    return checks
 
 
 if __name__ == "__main__":

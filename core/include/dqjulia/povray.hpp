@@ -93,9 +93,11 @@ struct PovrayFiles {
 DQJ_API PovrayFiles povrayFiles(const Params& params, const std::string& scenePath,
                                 const PovrayWriteOptions& options = {});
 
-/// Writes the files of povrayFiles(), each through a temporary file renamed into place (the
-/// include only if it is missing or differs from povrayInclude()). Every text is built and the
-/// grid baked before the first file is written. Returns the paths written.
+/// Writes the files of povrayFiles() (the include only if it is missing or differs from
+/// povrayInclude()), all of them or none: every text is built and the grid baked first, every
+/// file written to a temporary file, and only then are they renamed into place; if one cannot
+/// be, those already renamed are withdrawn (and the files they replaced put back). Returns the
+/// paths written.
 /// Throws ParamError (bad parameters or options), Cancelled, std::runtime_error (writing).
 DQJ_API std::vector<std::string> writePovray(const Params& params, const std::string& scenePath,
                                              const PovrayWriteOptions& options = {},
