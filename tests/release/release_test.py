@@ -126,6 +126,12 @@ def owner_of(path, data, deps, build):
     return owners[0] if len(owners) == 1 else (None if not owners else "ambiguous: " + ", ".join(owners))
 
 
+def without_trailing_blanks(path):
+    """A licence file's text as the notices hold it: no blanks at the ends of lines (notices.py)."""
+    text = path.read_text(encoding="utf-8", errors="replace").strip()
+    return "\n".join(line.rstrip() for line in text.split("\n"))
+
+
 def check_components(args, checks):
     data = components(args.source)
     fetched, key, applied, folders = build_deps_facts(args.source)
@@ -167,13 +173,22 @@ def check_components(args, checks):
             texts = [p for p in folder.iterdir() if p.name != "SOURCE"] if folder.is_dir() else []
             # Debian's source (its .dsc's version, when the mirror had it), or its upstream tarball;
             # for a package of the build machine, the package and its source.
-            match = re.search(r"(?:source package: |\(source )(\S+) (\S+)", record)
+            # A package of the build machine: its own version may be the component's where its
+            # source's is not (gcc-mingw-w64-base 12.2.0-14+25.2, of source gcc-mingw-w64 25.2).
+            match = re.search(r"(?:source package: |\(source )(\S+) ([^\s)]+)", record)
+            package = re.search(r"^Debian package: \S+ (\S+)", record, re.M)
             tarball = re.search(r"Upstream tarball: %s_%s\b" % (re.escape(source_name), re.escape(version)), record)
-            from_source = match is not None and match.group(1) == source_name and match.group(2).startswith(version)
+            from_source = (
+                match is not None
+                and match.group(1) == source_name
+                and (
+                    match.group(2).startswith(version) or (package is not None and package.group(1).startswith(version))
+                )
+            )
             what = "%s (%s): licence files %s, from %s" % (name, target, [p.name for p in texts], record.strip())
             checks[what] = bool(texts) and (from_source or tarball is not None)
             notices = (builds[target] / "licenses" / "THIRD-PARTY-NOTICES.txt").read_text(encoding="utf-8")
-            missing = [p.name for p in texts if p.read_text(encoding="utf-8", errors="replace").strip() not in notices]
+            missing = [p.name for p in texts if without_trailing_blanks(p) not in notices]
             checks["%s (%s): the notices hold its name and licence texts (missing: %s)" % (name, target, missing)] = (
                 "%s %s (%s)" % (name, version, component["license"]) in notices and not missing
             )
