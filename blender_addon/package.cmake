@@ -7,6 +7,8 @@
 #   dqjulia/lib/LIBRARY_NAME    the real library file (not a symlink), stripped: libdqjulia.so, or
 #                               dqjulia.dll in the Windows zip (PLATFORM windows-x64, the manifest's
 #                               platforms; EMULATOR runs the Windows dqjulia schema)
+#   dqjulia/LICENSE, dqjulia/THIRD-PARTY-NOTICES.txt    from LICENSES (build/licenses/)
+# The zip is reproducible (scripts/pack.py: sorted entries, SOURCE_DATE_EPOCH's time, fixed modes).
 cmake_minimum_required(VERSION 3.25)
 file(REMOVE_RECURSE "${STAGE}")
 file(MAKE_DIRECTORY "${STAGE}/dqjulia/lib" "${STAGE}/dqjulia/presets")
@@ -39,12 +41,10 @@ if(STRIP)  # the symbol table is for debuggers; the dynamic symbols (dqj_*) and 
     message(FATAL_ERROR "could not strip ${STAGE}/dqjulia/lib/${LIBRARY_NAME}")
   endif()
 endif()
+file(COPY "${LICENSES}/LICENSE" "${LICENSES}/THIRD-PARTY-NOTICES.txt" DESTINATION "${STAGE}/dqjulia")
 get_filename_component(zip_dir "${ZIP}" DIRECTORY)
 file(MAKE_DIRECTORY "${zip_dir}")
-file(REMOVE "${ZIP}.tmp")
-execute_process(COMMAND "${CMAKE_COMMAND}" -E tar cf "${ZIP}.tmp" --format=zip dqjulia
-                WORKING_DIRECTORY "${STAGE}" RESULT_VARIABLE result)
+execute_process(COMMAND "${PYTHON}" "${PACK}" zip "${ZIP}" "${STAGE}/dqjulia" RESULT_VARIABLE result)
 if(NOT result EQUAL 0)
   message(FATAL_ERROR "could not write ${ZIP}")
 endif()
-file(RENAME "${ZIP}.tmp" "${ZIP}")

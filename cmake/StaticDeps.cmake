@@ -4,8 +4,10 @@
 # OpenVDB, TBB or OpenEXR can slip into the link.
 #
 #   dqj::zlib dqj::png dqj::imath dqj::openexr dqj::tbb dqj::hwy dqj::lz4 dqj::blosc dqj::openvdb
+#   dqj::freetype
 #
-# (c-blosc, with LZ4 and zlib as its codecs, is OpenVDB's Blosc compression of the files it writes.)
+# (c-blosc, with LZ4 and zlib as its codecs, is OpenVDB's Blosc compression of the files it writes;
+# FreeType draws the command's contact sheet labels and is not in libdqjulia.)
 #
 # The global property DQJ_STATIC_DEPENDENCY_ARCHIVES lists their archives' file names (for
 # the linker's --exclude-libs).
@@ -65,3 +67,4 @@ dqj_static_dependency(lz4 ARCHIVES liblz4.a)
 dqj_static_dependency(blosc ARCHIVES libblosc.a LINKS dqj::lz4 dqj::zlib Threads::Threads)
 dqj_static_dependency(openvdb ARCHIVES libopenvdb.a LINKS dqj::tbb dqj::imath dqj::blosc dqj::zlib Threads::Threads
                       DEFINES ${dqj_openvdb_defines})
+dqj_static_dependency(freetype ARCHIVES libfreetype.a LINKS dqj::zlib INCLUDES "${dqj_deps_include}/freetype2")

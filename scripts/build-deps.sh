@@ -14,11 +14,23 @@
 # Zstd and Snappy, which OpenVDB never writes (Debian's libblosc1 links all four).
 #
 # for Linux x86-64 (position-independent), or for Windows x64 with MinGW-w64
-# (cmake/toolchains/mingw-w64-x86_64.cmake), where the command's and the tests' other libraries
-# come from Debian's sources too, since the build machine's own are Linux ones: FreeType 2.12.1
-# (contact sheets), GoogleTest 1.12.1, and the header-only GLM 0.9.9.8, nlohmann/json 3.11.2 and
-# CLI11 2.1.2. Boost stays header-only: the Windows prefix links to the system's Boost headers
-# (libboost-dev) in include/boost, which OpenVDB's headers include.
+# (cmake/toolchains/mingw-w64-x86_64.cmake). FreeType 2.12.1 (the command's contact sheets) is
+# built for both, so the command depends on nothing but glibc or Windows' own DLLs too. For
+# Windows the command's and the tests' other libraries come from Debian's sources as well, since
+# the build machine's own are Linux ones: GoogleTest 1.12.1, and the header-only GLM 0.9.9.8,
+# nlohmann/json 3.11.2 and CLI11 2.1.2 (the Linux build takes Debian's packages of the same
+# versions; their sources are fetched there too, for their licences). Boost stays header-only:
+# the Windows prefix links to the system's Boost headers (libboost-dev) in include/boost, which
+# OpenVDB's headers include.
+#
+# Licences: each component's licence and notice files, from its Debian source, go to
+# share/licenses/<Debian source package>/ in the prefix, with a SOURCE file naming the Debian
+# source and its upstream tarball's SHA-256; the toolchain's runtime libraries linked in
+# (libstdc++ and libgcc, MinGW-w64's runtime and winpthreads) and Boost's headers bring their
+# Debian packages' copyright files. The build assembles its notices from these
+# (scripts/notices.py, third_party/components.json); tests/release checks that both agree.
+# Paths of the temporary build folder are mapped away (-ffile-prefix-map), so the archives hold
+# none of them.
 #
 # Usage: scripts/build-deps.sh [--target linux-x64|windows-x64]           builds what is missing,
 #                                                                          then prints the prefix
@@ -47,11 +59,12 @@ done
 
 here=$(cd "$(dirname "$0")" && pwd)
 versions="zlib-1.2.13_png-1.6.39_imath-3.1.6_exr-3.1.5_tbb-2021.8.0_hwy-1.0.3_lz4-1.9.4_blosc-1.21.3_vdb-10.0.1"
+versions="${versions}_ft-2.12.1_glm-0.9.9.8_json-3.11.2_cli11-2.1.2"
 case "$target" in
-  linux-x64) recipe=6 ;;  # bump when the build options or patches below change
+  linux-x64) recipe=8 ;;  # bump when the build options, patches or licence files below change
   windows-x64)
-    versions="${versions}_ft-2.12.1_gtest-1.12.1_glm-0.9.9.8_json-3.11.2_cli11-2.1.2"
-    recipe=9 ;;
+    versions="${versions}_gtest-1.12.1"
+    recipe=11 ;;
   *) echo "dqjulia deps: unknown target '$target' (linux-x64 or windows-x64)" >&2; exit 2 ;;
 esac
 key="${versions}_r${recipe}"
@@ -117,6 +130,44 @@ fetch() {  # fetch PACKAGE ORIG_GLOB
   fi
   mkdir -p "$work/src/${1%%=*}"
   tar -xf "$orig" -C "$work/src/${1%%=*}" --strip-components=1
+  # Where it came from, for the notices: the Debian source's version (its .dsc, when the mirror
+  # has it) and the upstream tarball apt checked against Debian's index.
+  local dsc
+  dsc=$(ls "$work/src/${1%%=*}"_*.dsc 2>/dev/null | head -n 1 || true)
+  {
+    echo "Debian source package: ${1%%=*}${dsc:+ $(basename "$dsc" .dsc | sed 's/^[^_]*_//')}"
+    echo "Upstream tarball: $(basename "$orig") (SHA-256 $(sha256sum "$orig" | cut -d' ' -f1))"
+  } > "$work/src/${1%%=*}.source"
+}
+# licences SOURCE FILE...: a component's licence and notice files (paths in its source tree)
+# into share/licenses/SOURCE/ of the prefix, with its SOURCE record; names flattened (a/b -> a-b).
+licences() {
+  local source=$1 file
+  shift
+  mkdir -p "$stage/share/licenses/$source"
+  cp "$work/src/$source.source" "$stage/share/licenses/$source/SOURCE"
+  for file in "$@"; do
+    cp "$work/src/$source/$file" "$stage/share/licenses/$source/${file//\//-}" \
+      || { echo "dqjulia deps: $source has no licence file $file" >&2; exit 1; }
+  done
+}
+# system_licence NAME PACKAGE [DEP5_LICENSE]: the copyright file of an installed Debian package
+# (the toolchain's runtime libraries, Boost's headers) into share/licenses/NAME/; with
+# DEP5_LICENSE only that licence's stand-alone paragraph of it (Boost's file has 46,000 lines).
+system_licence() {
+  local name=$1 package=$2 licence=${3:-} copyright=/usr/share/doc/$2/copyright
+  mkdir -p "$stage/share/licenses/$name"
+  dpkg-query -W -f 'Debian package: ${Package} ${Version} (source ${source:Package} ${source:Version})\n' "$package" \
+    > "$stage/share/licenses/$name/SOURCE" \
+    || { echo "dqjulia deps: the Debian package $package is not installed" >&2; exit 1; }
+  if [ -z "$licence" ]; then
+    cp "$copyright" "$stage/share/licenses/$name/copyright"
+  else  # the paragraph "License: NAME" followed by its text (lines starting with a space)
+    awk -v want="License: $licence" '{ if (on && /^ /) print; else on = (prev == "" && $0 == want); prev = $0 }' \
+      "$copyright" | sed 's/^ \.$//; s/^ //' > "$stage/share/licenses/$name/$licence.txt"
+    [ -s "$stage/share/licenses/$name/$licence.txt" ] \
+      || { echo "dqjulia deps: no $licence text in $copyright" >&2; exit 1; }
+  fi
 }
 fetch zlib 'zlib_1.2.13*.orig.tar.*'
 fetch libpng1.6 'libpng1.6_1.6.39.orig.tar.*'
@@ -127,19 +178,25 @@ fetch highway 'highway_1.0.3.orig.tar.*'
 fetch lz4 'lz4_1.9.4.orig.tar.*'
 fetch c-blosc 'c-blosc_1.21.3*.orig.tar.*'
 fetch openvdb 'openvdb_10.0.1.orig.tar.*'
+fetch freetype 'freetype_2.12.1*.orig.tar.*'
+fetch glm 'glm_0.9.9.8*.orig.tar.*'
+fetch nlohmann-json3 'nlohmann-json3_3.11.2.orig.tar.*'
+fetch cli11 'cli11_2.1.2*.orig.tar.*'
+# oneTBB: a thread the system refuses (ulimit -u, ulimit -v) means fewer threads, not std::terminate.
+patch -d "$work/src/onetbb" -p1 --quiet < "$here/patches/onetbb-2021.8.0-thread-launch-failures.patch" \
+  || { echo "dqjulia deps: patching oneTBB failed" >&2; exit 1; }
 # OpenVDB's readers made safe for damaged files (each patch says what and why).
 for fix in compression-bounds read-bools node-origins read-failures; do
   patch -d "$work/src/openvdb" -p1 --quiet < "$here/patches/openvdb-10.0.1-$fix.patch" \
     || { echo "dqjulia deps: patching OpenVDB ($fix) failed" >&2; exit 1; }
 done
 if [ "$target" = windows-x64 ]; then
-  fetch freetype 'freetype_2.12.1*.orig.tar.*'
   fetch googletest 'googletest_1.12.1.orig.tar.*'
-  fetch glm 'glm_0.9.9.8*.orig.tar.*'
-  fetch nlohmann-json3 'nlohmann-json3_3.11.2.orig.tar.*'
-  fetch cli11 'cli11_2.1.2*.orig.tar.*'
 fi
 log "sources fetched"
+# The temporary folder's paths (in assertion messages, __FILE__) become a fixed name.
+prefix_map="-ffile-prefix-map=$work=/usr/src/dqjulia-deps"
+export CFLAGS="$prefix_map" CXXFLAGS="$prefix_map"
 
 common=(-DCMAKE_BUILD_TYPE=Release -DCMAKE_POSITION_INDEPENDENT_CODE=ON -DBUILD_SHARED_LIBS=OFF
         "-DCMAKE_INSTALL_PREFIX=$stage" "-DCMAKE_PREFIX_PATH=$stage" -DCMAKE_INSTALL_LIBDIR=lib
@@ -158,8 +215,8 @@ build() {  # build NAME [CMAKE OPTIONS...]
 }
 
 # zlib: its own configure makes only the static archive (CHOST: for MinGW).
-zlib_env=(CFLAGS="-O2 -fPIC")
-[ "$target" = windows-x64 ] && zlib_env=(CHOST=$mingw CC=$mingw-gcc-posix CFLAGS="-O2")
+zlib_env=(CFLAGS="-O2 -fPIC $prefix_map")
+[ "$target" = windows-x64 ] && zlib_env=(CHOST=$mingw CC=$mingw-gcc-posix CFLAGS="-O2 $prefix_map")
 (cd "$work/src/zlib" && env "${zlib_env[@]}" ./configure --static --prefix="$stage" >"$work/zlib.log" 2>&1 \
   && make -j"$jobs" libz.a >>"$work/zlib.log" 2>&1 && make install >>"$work/zlib.log" 2>&1) \
   || { tail -n 40 "$work/zlib.log" >&2; echo "dqjulia deps: building zlib failed" >&2; exit 1; }
@@ -167,8 +224,8 @@ log "built zlib"
 zlib_opts=("-DZLIB_ROOT=$stage" "-DZLIB_LIBRARY=$stage/lib/libz.a" "-DZLIB_INCLUDE_DIR=$stage/include")
 
 # LZ4: its own Makefile's static archive alone (its CMake builds the command too), for c-blosc.
-lz4_env=(CFLAGS="-O2 -fPIC")
-[ "$target" = windows-x64 ] && lz4_env=(CC=$mingw-gcc-posix AR=$mingw-ar CFLAGS="-O2")
+lz4_env=(CFLAGS="-O2 -fPIC $prefix_map")
+[ "$target" = windows-x64 ] && lz4_env=(CC=$mingw-gcc-posix AR=$mingw-ar CFLAGS="-O2 $prefix_map")
 (cd "$work/src/lz4/lib" && env "${lz4_env[@]}" make -j"$jobs" liblz4.a >"$work/lz4.log" 2>&1 \
   && mkdir -p "$stage/lib" "$stage/include" && cp liblz4.a "$stage/lib/" \
   && cp lz4.h lz4hc.h lz4frame.h "$stage/include/") \
@@ -217,8 +274,8 @@ cp "$work/src/highway/hwy/contrib/math/"*.h "$stage/include/hwy/contrib/math/"
 # found), static only, its symbols hidden (HIDE_SYMBOLS: no export attribute in a static build).
 # MinGW: its shuffle.c calls _xgetbv (behind a CPUID check), an intrinsic GCC allows only with
 # -mxsave (CFLAGS joins the toolchain's flags rather than replacing them).
-blosc_cflags=
-[ "$target" = windows-x64 ] && blosc_cflags=-mxsave
+blosc_cflags=$prefix_map
+[ "$target" = windows-x64 ] && blosc_cflags="$prefix_map -mxsave"
 CFLAGS=$blosc_cflags build c-blosc "${zlib_opts[@]}" -DBUILD_SHARED=OFF -DBUILD_STATIC=ON -DBUILD_TESTS=OFF \
   -DBUILD_FUZZERS=OFF -DBUILD_BENCHMARKS=OFF -DHIDE_SYMBOLS=ON -DPREFER_EXTERNAL_LZ4=ON \
   "-DLZ4_INCLUDE_DIR=$stage/include" "-DLZ4_LIBRARY=$stage/lib/liblz4.a" -DPREFER_EXTERNAL_ZLIB=ON \
@@ -240,10 +297,10 @@ build openvdb "${zlib_opts[@]}" "-DTBB_ROOT=$stage" -DOPENVDB_CORE_SHARED=OFF -D
   -DUSE_EXPLICIT_INSTANTIATION=OFF \
   -DOPENVDB_USE_DELAYED_LOADING=OFF -DUSE_PKGCONFIG=OFF "${openvdb_opts[@]}"
 
+# FreeType with our zlib (without it, it compiles a copy of zlib in, whose symbols clash with it).
+build freetype "${zlib_opts[@]}" -DFT_REQUIRE_ZLIB=ON -DFT_DISABLE_BZIP2=ON -DFT_DISABLE_PNG=ON \
+  -DFT_DISABLE_HARFBUZZ=ON -DFT_DISABLE_BROTLI=ON
 if [ "$target" = windows-x64 ]; then
-  # FreeType with our zlib (without it, it compiles a copy of zlib in, whose symbols clash with it).
-  build freetype "${zlib_opts[@]}" -DFT_REQUIRE_ZLIB=ON -DFT_DISABLE_BZIP2=ON -DFT_DISABLE_PNG=ON \
-    -DFT_DISABLE_HARFBUZZ=ON -DFT_DISABLE_BROTLI=ON
   build googletest -DBUILD_GMOCK=OFF -DINSTALL_GTEST=ON
   build nlohmann-json3 -DJSON_BuildTests=OFF -DJSON_Install=ON
   build cli11 -DCLI11_BUILD_TESTS=OFF -DCLI11_BUILD_EXAMPLES=OFF -DCLI11_BUILD_DOCS=OFF -DCLI11_INSTALL=ON
@@ -255,6 +312,32 @@ if [ "$target" = windows-x64 ]; then
   sed -i 's/^\(cmake_minimum_required(VERSION\|cmake_policy(VERSION\) 3\.2/\1 3.2...3.25/' \
     "$stage/glm/cmake/glm/glmConfig.cmake"
   log "installed glm"
+fi
+
+# Licences (see the top): each component's from its source, the toolchain's from its packages.
+licences zlib LICENSE
+licences libpng1.6 LICENSE
+licences imath LICENSE.md
+licences openexr LICENSE.md
+# oneTBB's third-party file holds the notices of the code it includes (ITT notify among them).
+licences onetbb LICENSE.txt third-party-programs.txt
+licences highway LICENSE
+licences lz4 lib/LICENSE
+# c-blosc's own, and of the code compiled into it: bitshuffle and FastLZ (blosclz). Its codecs
+# are our LZ4 and zlib (their own entries); Snappy, Zstd and the MSVC stdint.h are not built.
+licences c-blosc LICENSES/BLOSC.txt LICENSES/BITSHUFFLE.txt LICENSES/FASTLZ.txt
+licences openvdb LICENSE
+# FreeType under the FreeType License (of its two); its BDF and PCF drivers' licences.
+licences freetype LICENSE.TXT docs/FTL.TXT src/bdf/README src/pcf/README
+licences glm copying.txt
+licences nlohmann-json3 LICENSE.MIT
+licences cli11 LICENSE
+system_licence boost "$(dpkg -S /usr/include/boost/version.hpp | cut -d: -f1)" BSL-1.0  # libboost1.74-dev
+if [ "$target" = windows-x64 ]; then
+  system_licence gcc-runtime gcc-mingw-w64-base          # libstdc++, libgcc (GCC Runtime Library Exception)
+  system_licence mingw-w64-runtime mingw-w64-x86-64-dev  # the C runtime's startup code, winpthreads
+else
+  system_licence gcc-runtime "gcc-$(c++ -dumpversion | cut -d. -f1)-base"  # libstdc++, libgcc
 fi
 
 echo "$versions" > "$stage/.complete"

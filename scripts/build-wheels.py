@@ -13,9 +13,10 @@
 A wheel holds what `cmake --install BUILD --component python` and `--component python_native`
 install (python/CMakeLists.txt: the modules of python/dqjulia/ with _buildinfo.py, the stripped
 library in dqjulia/lib/ and the command in dqjulia/bin/), and a .dist-info with the metadata of
-pyproject.toml's [project] table, the console script `dqjulia`, the licences (BUILD/licenses/, or
-LICENSE) and a RECORD of every file's SHA-256 and size. Its tag is py3-none-PLATFORM: the package
-loads the library with ctypes, so one wheel a platform serves every CPython from 3.9 on.
+pyproject.toml's [project] table, the console script `dqjulia`, the licences (BUILD/licenses/:
+LICENSE, the platform's third-party notices, THIRD-PARTY.json) and a RECORD of every file's
+SHA-256 and size. Its tag is py3-none-PLATFORM: the package loads the library with ctypes, so one
+wheel a platform serves every CPython from 3.9 on.
 
 The sdist holds the files of the source tree that git knows (committed or not ignored), less
 pyproject.toml's sdist.exclude, and PKG-INFO: what scikit-build-core (pyproject.toml's build
@@ -23,14 +24,14 @@ backend) needs to build the wheel from source (python/README.md, "Building from 
 
 Reproducible: every entry's time is SOURCE_DATE_EPOCH (default: the source tree's last commit's
 time), entries are sorted, modes are 0644 or 0755, owners root, no user or host names; two runs
-on the same build trees write the same bytes. Each file is written aside and renamed into place.
+on the same build trees write the same bytes (scripts/pack.py writes them, aside, renamed into
+place when whole).
 Needs Python 3.11 (tomllib) and cmake.
 """
 
 import argparse
 import base64
 import csv
-import gzip
 import hashlib
 import io
 import os
@@ -38,15 +39,13 @@ import re
 import shutil
 import subprocess
 import sys
-import tarfile
 import tempfile
-import time
 import tomllib
-import zipfile
 from pathlib import Path
 
-SOURCE = Path(__file__).resolve().parent.parent
-ZIP_EPOCH = 315532800  # 1980-01-01: the earliest time a zip entry holds
+from build_tree import SOURCE, BuildTreeError, check_build
+from pack import PackError, write_tar_gz, write_zip
+
 # CMAKE_SYSTEM_NAME -> the wheel's platform tag and the native files its package holds.
 PLATFORMS = {
     "Linux": ("manylinux_2_34_x86_64", ("lib/libdqjulia.so", "bin/dqjulia")),
@@ -108,27 +107,10 @@ def core_metadata(pyproject, version, license_files):
     return (text + "\n" + readme).encode("utf-8")
 
 
-def cache_value(build, name):
-    """A variable of BUILD/CMakeCache.txt."""
-    cache = build / "CMakeCache.txt"
-    if not cache.is_file():
-        raise BuildError("%s is not a CMake build tree (no CMakeCache.txt)" % build)
-    for line in cache.read_text(encoding="utf-8", errors="replace").splitlines():
-        key, _, value = line.partition("=")
-        if key.split(":")[0] == name:
-            return value
-    return None
-
-
 def stage(build, system, into):
     """Installs the package's components of a build tree for `system` into `into`; returns the
     wheel's platform tag."""
-    found = cache_value(build, "CMAKE_SYSTEM_NAME") or "Linux"
-    if found != system:
-        raise BuildError("%s is a build for %s, not for %s" % (build, found, system))
-    home = cache_value(build, "CMAKE_HOME_DIRECTORY")
-    if home is None or Path(home).resolve() != SOURCE:
-        raise BuildError("%s is a build of %s, not of this source tree %s" % (build, home, SOURCE))
+    check_build(build, system)
     for component in COMPONENTS:
         result = subprocess.run(
             ["cmake", "--install", str(build), "--component", component, "--prefix", str(into)],
@@ -167,23 +149,6 @@ def record_hash(data):
     return "sha256=" + base64.urlsafe_b64encode(hashlib.sha256(data).digest()).rstrip(b"=").decode()
 
 
-def write_zip(path, entries, epoch):
-    """entries: (name, bytes, mode) in the order to write. Written aside, renamed into place."""
-    stamp = time.gmtime(max(epoch, ZIP_EPOCH))[:6]
-    temporary = path.with_name("." + path.name + ".tmp")
-    try:
-        with zipfile.ZipFile(temporary, "w") as archive:
-            for name, data, mode in entries:
-                info = zipfile.ZipInfo(name, stamp)
-                info.create_system = 3  # Unix, so that the modes are read
-                info.external_attr = (0o100000 | mode) << 16
-                info.compress_type = zipfile.ZIP_DEFLATED
-                archive.writestr(info, data, compresslevel=9)
-        os.replace(temporary, path)
-    finally:
-        temporary.unlink(missing_ok=True)
-
-
 def build_wheel(build, system, pyproject, version, epoch, out):
     project = pyproject["project"]
     name = project["name"]
@@ -196,12 +161,12 @@ def build_wheel(build, system, pyproject, version, epoch, out):
         entries = [(relative, path.read_bytes(), mode_of(path)) for relative, path in files_under(staged)]
 
         info = "%s-%s.dist-info" % (name, version)
+        # The build's licences/ (the top-level CMakeLists.txt: LICENSE, the third-party notices of
+        # this platform, THIRD-PARTY.json), as every package of the release carries them.
         licenses = build / "licenses"
-        # TODO(issue 36): every build tree has licenses/ (LICENSE, the third-party notices, the
-        # component list) once the release helper's build writes it; until then the project's LICENSE.
-        license_paths = files_under(licenses) if licenses.is_dir() else [("LICENSE", SOURCE / "LICENSE")]
-        if not any(relative == "LICENSE" for relative, _ in license_paths):
-            license_paths.insert(0, ("LICENSE", SOURCE / "LICENSE"))
+        license_paths = files_under(licenses)
+        if "LICENSE" not in [relative for relative, _ in license_paths]:
+            raise BuildError("%s has no LICENSE: is the build complete?" % licenses)
         for relative, path in license_paths:
             entries.append(("%s/licenses/%s" % (info, relative), path.read_bytes(), 0o644))
         entries.append(("%s/METADATA" % info, core_metadata(pyproject, version, [r for r, _ in license_paths]), 0o644))
@@ -255,24 +220,8 @@ def build_sdist(pyproject, version, epoch, out):
             raise BuildError("%s is a symbolic link, which the sdist does not hold" % path)
         members.append(("%s/%s" % (top, relative), path.read_bytes(), mode_of(path)))
     members.sort()
-    data = io.BytesIO()
-    with tarfile.open(fileobj=data, mode="w", format=tarfile.PAX_FORMAT) as archive:
-        for member_name, contents, mode in members:
-            info = tarfile.TarInfo(member_name)
-            info.size = len(contents)
-            info.mtime = epoch
-            info.mode = mode
-            info.uid = info.gid = 0
-            info.uname = info.gname = "root"
-            archive.addfile(info, io.BytesIO(contents))
     path = out / (top + ".tar.gz")
-    temporary = path.with_name("." + path.name + ".tmp")
-    try:
-        with temporary.open("wb") as raw, gzip.GzipFile(filename="", mode="wb", fileobj=raw, mtime=epoch) as packed:
-            packed.write(data.getvalue())
-        os.replace(temporary, path)
-    finally:
-        temporary.unlink(missing_ok=True)
+    write_tar_gz(path, members, epoch)
     return path
 
 
@@ -301,7 +250,7 @@ def main():
         written = [build_wheel(build, system, pyproject, version, epoch, args.out) for build, system in builds]
         if not args.no_sdist:
             written.append(build_sdist(pyproject, version, epoch, args.out))
-    except (BuildError, OSError) as error:
+    except (BuildError, BuildTreeError, PackError, OSError) as error:
         raise SystemExit("build-wheels: %s" % error) from None
     for path in written:
         print(path)

@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # The README's second command: install what is missing, build, and run every test:
-# first the Release build, then the Windows cross build's tests under Wine (against the Release
-# build), then the whole suite again built with clang under AddressSanitizer and
-# UndefinedBehaviorSanitizer, with the libFuzzer targets run for a bounded time.
+# first the Release build and the Windows cross build, then the Release build's tests (among them
+# the release tests, which package both builds as scripts/release.sh does), then the Windows
+# build's tests under Wine (against the Release build), then the whole suite again built with
+# clang under AddressSanitizer and UndefinedBehaviorSanitizer, with the libFuzzer targets run for
+# a bounded time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
@@ -21,11 +23,12 @@ if ! wait "$venvs"; then
 fi
 cat "$venvs_log"
 scripts/build.sh
+echo "dqjulia: Windows cross build (MinGW-w64)"
+scripts/build-windows.sh
 # Label `long` (tiled bakes at farm sizes, minutes) is run by hand: ctest --test-dir build -L long
 ctest --test-dir build --output-on-failure -j"$(nproc)" -LE long
 
-echo "dqjulia: Windows cross build (MinGW-w64) and its tests under Wine"
-scripts/build-windows.sh
+echo "dqjulia: the Windows build's tests under Wine"
 ctest --test-dir build-windows --output-on-failure -j"$(nproc)"
 
 echo "dqjulia: sanitizer and fuzzing run (clang, ASan + UBSan)"

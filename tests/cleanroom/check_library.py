@@ -1,7 +1,9 @@
 """Checks that a libdqjulia.so is self-contained: it needs no shared library but glibc's own,
-no glibc symbol version newer than the floor, and exports nothing but the C ABI (dqj_*).
+no glibc symbol version newer than the floor, no search path (RPATH, RUNPATH) but one relative to
+itself ($ORIGIN), and exports nothing but the C ABI (dqj_*). With --program, the same for the
+dqjulia command, whose exports are not checked.
 
-Usage: python3 check_library.py LIBRARY [--glibc-floor 2.34]
+Usage: python3 check_library.py LIBRARY [--glibc-floor 2.34] [--program]
 Prints the NEEDED list, the highest GLIBC_ version and the exported symbols' count.
 """
 
@@ -26,14 +28,20 @@ def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("library")
     parser.add_argument("--glibc-floor", default="2.34")
+    parser.add_argument("--program", action="store_true", help="an executable: its exports are not checked")
     args = parser.parse_args()
     failures = []
 
-    needed = re.findall(r"\(NEEDED\)\s+Shared library: \[([^\]]+)\]", run("readelf", "-d", args.library))
+    dynamic = run("readelf", "-d", args.library)
+    needed = re.findall(r"\(NEEDED\)\s+Shared library: \[([^\]]+)\]", dynamic)
     print("NEEDED:", " ".join(needed))
     for name in needed:
         if name not in ALLOWED_NEEDED:
             failures.append("needs %s, which is not one of glibc's own libraries" % name)
+    for kind, path in re.findall(r"\((RPATH|RUNPATH)\)\s+Library \w+: \[([^\]]*)\]", dynamic):
+        print("%s: %s" % (kind, path))
+        if any(part and not part.startswith("$ORIGIN") for part in path.split(":")):
+            failures.append("its %s %s names a folder of the build machine" % (kind, path))
 
     symbols = run("objdump", "-T", args.library).splitlines()
     versions = {}
@@ -57,6 +65,8 @@ def main():
                 "needs GLIBC_%s (above the floor %s) for %s" % (version, args.glibc_floor, ", ".join(names))
             )
 
+    if args.program:
+        exported = []
     strays = [name for name in exported if not name.startswith("dqj_")]
     print("exported symbols: %d (dqj_*), %d others" % (len(exported) - len(strays), len(strays)))
     if strays:

@@ -1,10 +1,18 @@
 # Installs the build into WORK/prefix (cmake --install), then builds consumer.c against it
-# twice, through find_package(dqjulia) and through pkg-config, and runs both programs.
+# twice, through find_package(dqjulia) (asking for this version: same major version) and through
+# pkg-config, and runs both programs.
 # -DBUILD=<build tree> -DSOURCE=<this folder> -DWORK=<scratch> -DCC=<C compiler>
+# or, instead of BUILD, -DPREFIX=<an install tree made elsewhere> (tests/release: the unpacked archive)
 cmake_minimum_required(VERSION 3.25)
 include(${CMAKE_CURRENT_LIST_DIR}/../script_support.cmake)  # dqj_run
 file(REMOVE_RECURSE "${WORK}")
-set(prefix "${WORK}/prefix")
+file(STRINGS "${CMAKE_CURRENT_LIST_DIR}/../../VERSION" version LIMIT_COUNT 1)
+if(DEFINED PREFIX)
+  set(prefix "${PREFIX}")
+else()
+  set(prefix "${WORK}/prefix")
+  dqj_run(${CMAKE_COMMAND} --install "${BUILD}" --prefix "${prefix}")
+endif()
 
 function(check_output what)
   if(NOT out MATCHES "^dqjulia [0-9]+\\.[0-9]+\\.[0-9]+ n=[0-9]+ de=[0-9.]+")
@@ -13,7 +21,6 @@ function(check_output what)
   message(STATUS "ok: ${what}: ${out}")
 endfunction()
 
-dqj_run(${CMAKE_COMMAND} --install "${BUILD}" --prefix "${prefix}")
 foreach(file include/dqjulia/dqjulia.h lib/libdqjulia.so lib/cmake/dqjulia/dqjuliaConfig.cmake
              lib/cmake/dqjulia/dqjuliaConfigVersion.cmake lib/pkgconfig/dqjulia.pc)
   if(NOT EXISTS "${prefix}/${file}")
@@ -22,7 +29,8 @@ foreach(file include/dqjulia/dqjulia.h lib/libdqjulia.so lib/cmake/dqjulia/dqjul
 endforeach()
 
 # find_package(dqjulia)
-dqj_run(${CMAKE_COMMAND} -S "${SOURCE}" -B "${WORK}/cmake-build" "-DCMAKE_PREFIX_PATH=${prefix}" "-DCMAKE_C_COMPILER=${CC}")
+dqj_run(${CMAKE_COMMAND} -S "${SOURCE}" -B "${WORK}/cmake-build" "-DCMAKE_PREFIX_PATH=${prefix}" "-DCMAKE_C_COMPILER=${CC}"
+        "-DDQJ_WANTED_VERSION=${version}")
 dqj_run(${CMAKE_COMMAND} --build "${WORK}/cmake-build")
 dqj_run(${CMAKE_COMMAND} -E env "LD_LIBRARY_PATH=${prefix}/lib" "${WORK}/cmake-build/consumer")
 check_output("find_package(dqjulia)")

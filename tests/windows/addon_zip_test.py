@@ -1,9 +1,10 @@
 """The add-on's Windows zip against the Linux one (one zip a platform, as Blender's
 `extension build --split-platforms` makes them): the Windows zip holds dqjulia/lib/dqjulia.dll
 and its manifest says platforms = ["windows-x64"], the Linux zip lib/libdqjulia.so and
-["linux-x64"]; every other file is the same (schema.json, written by dqjulia.exe under Wine, the
-same document). And native.py from the Windows zip, told it runs on Windows (sys.platform "win32";
-no Windows Python runs here), finds lib/dqjulia.dll beside itself, adds that folder to the DLL
+["linux-x64"]; both hold LICENSE and their platform's THIRD-PARTY-NOTICES.txt; every other file
+is the same (schema.json, written by dqjulia.exe under Wine, the same document). And native.py
+from the Windows zip, told it runs on Windows (sys.platform "win32"; no Windows Python runs here),
+finds lib/dqjulia.dll beside itself, adds that folder to the DLL
 search path (os.add_dll_directory) before loading it, and binds every function through ctypes
 (a stand-in for the DLL answers).
 
@@ -84,7 +85,12 @@ def main():
         ) and not any(name.endswith(".dll") for name in linux_names)
         checks["Windows manifest: platforms = %s" % platforms(windows)] = platforms(windows) == '["windows-x64"]'
         checks["Linux manifest: platforms = %s" % platforms(linux)] = platforms(linux) == '["linux-x64"]'
-        shared = (windows_names & linux_names) - {"dqjulia/blender_manifest.toml", "dqjulia/schema.json"}
+        # The third-party notices are each platform's (Windows adds MinGW-w64's runtime).
+        notices = "dqjulia/THIRD-PARTY-NOTICES.txt"
+        checks["both zips hold LICENSE and %s" % notices] = all(
+            {"dqjulia/LICENSE", notices} <= names for names in (windows_names, linux_names)
+        )
+        shared = (windows_names & linux_names) - {"dqjulia/blender_manifest.toml", "dqjulia/schema.json", notices}
         others = (windows_names ^ linux_names) - {"dqjulia/lib/dqjulia.dll", "dqjulia/lib/libdqjulia.so"}
         checks["the same files but the library: %s" % sorted(others)] = not others
         differing = sorted(name for name in shared if windows.read(name) != linux.read(name))

@@ -3,6 +3,13 @@
  * The one stable surface of the library, for C programs and for hosts that load it
  * at run time (the Blender add-on uses it through ctypes).
  *
+ * Versions: from 1.0.0 on this ABI follows semantic versioning (DQJ_VERSION_*, the library's
+ * file name libdqjulia.so.MAJOR). A program built against MAJOR.MINOR runs with any library of
+ * the same MAJOR and the same or a later MINOR: within a major version functions, status codes,
+ * feature names and fields at the end of growable structs are only added, never removed or
+ * changed. Any incompatible change makes the next major version. (Before 1.0 a minor version
+ * could break it.)
+ *
  * - Opaque handles: a dqj_context holds a parameter set and the text of its last error.
  * - Every call returns a dqj_status; on failure dqj_context_error() tells why. There is
  *   no global error buffer, and no C++ exception ever crosses this boundary.
