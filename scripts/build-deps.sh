@@ -61,10 +61,10 @@ here=$(cd "$(dirname "$0")" && pwd)
 versions="zlib-1.2.13_png-1.6.39_imath-3.1.6_exr-3.1.5_tbb-2021.8.0_hwy-1.0.3_lz4-1.9.4_blosc-1.21.3_vdb-10.0.1"
 versions="${versions}_ft-2.12.1_glm-0.9.9.8_json-3.11.2_cli11-2.1.2"
 case "$target" in
-  linux-x64) recipe=8 ;;  # bump when the build options, patches or licence files below change
+  linux-x64) recipe=9 ;;  # bump when the build options, patches or licence files below change
   windows-x64)
     versions="${versions}_gtest-1.12.1"
-    recipe=11 ;;
+    recipe=12 ;;
   *) echo "dqjulia deps: unknown target '$target' (linux-x64 or windows-x64)" >&2; exit 2 ;;
 esac
 key="${versions}_r${recipe}"
@@ -182,11 +182,15 @@ fetch freetype 'freetype_2.12.1*.orig.tar.*'
 fetch glm 'glm_0.9.9.8*.orig.tar.*'
 fetch nlohmann-json3 'nlohmann-json3_3.11.2.orig.tar.*'
 fetch cli11 'cli11_2.1.2*.orig.tar.*'
-# oneTBB: a thread the system refuses (ulimit -u, ulimit -v) means fewer threads, not std::terminate.
-patch -d "$work/src/onetbb" -p1 --quiet < "$here/patches/onetbb-2021.8.0-thread-launch-failures.patch" \
-  || { echo "dqjulia deps: patching oneTBB failed" >&2; exit 1; }
-# OpenVDB's readers made safe for damaged files (each patch says what and why).
-for fix in compression-bounds read-bools node-origins read-failures; do
+# oneTBB: a thread the system refuses (ulimit -u, ulimit -v) means fewer threads, and a task's
+# exception without memory to hold it a bad_alloc, not std::terminate (each patch says why).
+for fix in thread-launch-failures exception-out-of-memory; do
+  patch -d "$work/src/onetbb" -p1 --quiet < "$here/patches/onetbb-2021.8.0-$fix.patch" \
+    || { echo "dqjulia deps: patching oneTBB ($fix) failed" >&2; exit 1; }
+done
+# OpenVDB's readers made safe for damaged files, and its accessors for exhausted memory (each
+# patch says what and why).
+for fix in compression-bounds read-bools node-origins read-failures accessor-registration; do
   patch -d "$work/src/openvdb" -p1 --quiet < "$here/patches/openvdb-10.0.1-$fix.patch" \
     || { echo "dqjulia deps: patching OpenVDB ($fix) failed" >&2; exit 1; }
 done
