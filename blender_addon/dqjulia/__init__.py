@@ -12,7 +12,7 @@ osl.py, shaders/.
 bl_info = {
     "name": "DQ Julia",
     "author": "dqjulia",
-    "version": (0, 1, 0),  # the build writes the project's VERSION here
+    "version": (1, 0, 0),  # the build writes the project's VERSION here
     "blender": (3, 4, 0),
     "location": "View3D > Add > DQ Julia; View3D > Sidebar > DQ Julia; Properties > Object",
     "description": "Dual-quaternion Julia fractals: GLSL preview, OpenVDB volume and mesh bakes, OSL volume",

@@ -56,7 +56,7 @@ extern "C" {
 
 /* MAJOR*10000 + MINOR*100 + PATCH of the library actually loaded. */
 DQJ_API unsigned dqj_version_number(void);
-/* "0.1.0" */
+/* The loaded library's version as text, e.g. "1.0.0" */
 DQJ_API const char* dqj_version_string(void);
 
 typedef enum dqj_status {
