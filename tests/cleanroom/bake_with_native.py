@@ -10,12 +10,18 @@ import importlib.util
 import json
 import os
 import sys
+import types
 
 
 def load_native(addon_dir):
-    # native.py alone, as a module of a stand-in package: the add-on's __init__ needs bpy.
-    spec = importlib.util.spec_from_file_location("dqjulia_native", os.path.join(addon_dir, "native.py"))
+    # native.py as a module of a stand-in package over the add-on's folder, so that it finds its
+    # _buildinfo.py (the version it was built for) as in Blender; the add-on's __init__ needs bpy.
+    package = types.ModuleType("dqjulia_addon")
+    package.__path__ = [addon_dir]
+    sys.modules["dqjulia_addon"] = package
+    spec = importlib.util.spec_from_file_location("dqjulia_addon.native", os.path.join(addon_dir, "native.py"))
     module = importlib.util.module_from_spec(spec)
+    sys.modules["dqjulia_addon.native"] = module
     spec.loader.exec_module(module)
     return module
 

@@ -78,10 +78,12 @@ def build_deps_facts(source):
     text = (source / "scripts" / "build-deps.sh").read_text(encoding="utf-8")
     fetched = dict(re.findall(r"^\s*fetch (\S+) '[^_']+_([0-9][0-9.]*[0-9])", text, re.M))
     key = " ".join(re.findall(r'^\s*versions="([^"]*)"', text, re.M))
-    fixes = re.search(r"^for fix in ([^;]+); do", text, re.M).group(1).split()
     applied = {}
-    for folder, patch in re.findall(r'patch -d "\$work/src/([^"]+)"[^<\n]*< "\$here/patches/([^"]+)"', text):
-        names = [patch.replace("$fix", fix) for fix in fixes] if "$fix" in patch else [patch]
+    for match in re.finditer(r'patch -d "\$work/src/([^"]+)"[^<\n]*< "\$here/patches/([^"]+)"', text):
+        folder, patch = match.groups()
+        # "$fix" takes the words of the loop that holds the line: the last "for fix in" before it.
+        loops = re.findall(r"^for fix in ([^;]+); do", text[: match.start()], re.M)
+        names = [patch.replace("$fix", fix) for fix in loops[-1].split()] if "$fix" in patch else [patch]
         applied.setdefault(folder, []).extend(names)
     folders = set(re.findall(r"^\s*licences (\S+)", text, re.M))
     folders |= set(re.findall(r"^\s*system_licence (\S+)", text, re.M))
