@@ -246,6 +246,8 @@ def main():
             pyproject = tomllib.load(file)
         version = project_version(SOURCE)
         epoch = source_date_epoch(SOURCE)
+        # The installs' strip too: MinGW's strip writes the time into a PE header, SOURCE_DATE_EPOCH's if set.
+        os.environ["SOURCE_DATE_EPOCH"] = str(epoch)
         args.out.mkdir(parents=True, exist_ok=True)
         written = [build_wheel(build, system, pyproject, version, epoch, args.out) for build, system in builds]
         if not args.no_sdist:
