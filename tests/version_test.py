@@ -8,9 +8,12 @@ dqj_version_string()/dqj_version_number(), and that CHANGELOG.md has a section f
 
 import ast
 import ctypes
+import os
 import re
+import shutil
 import subprocess
 import sys
+import tempfile
 import tomllib
 import zipfile
 
@@ -56,6 +59,29 @@ def main():
     lib.dqj_version_number.restype = ctypes.c_uint
     text, number = lib.dqj_version_string().decode(), lib.dqj_version_number()
     checks["library %s (%d)" % (text, number)] = text == version and number == major * 10000 + minor * 100 + patch
+
+    # The bindings without their build info: in the source tree they expect the VERSION file's
+    # library; a copy elsewhere cannot tell and refuses to load any library.
+    probe = (
+        "import sys; sys.path.insert(0, sys.argv[1]); from dqjulia import _native as n; "
+        "print(n.EXPECTED_VERSION); print(n.load_error() or 'loaded')"
+    )
+    environment = dict(os.environ, DQJULIA_LIBRARY=library)
+    lines = subprocess.run(
+        [sys.executable, "-c", probe, source + "/python"], capture_output=True, text=True, check=True, env=environment
+    ).stdout.splitlines()
+    checks["source tree's _native.py expects %s and loads the library" % lines[0]] = lines == [
+        str(major * 10000 + minor * 100 + patch),
+        "loaded",
+    ]
+    with tempfile.TemporaryDirectory() as scratch:
+        shutil.copytree(source + "/python/dqjulia", scratch + "/dqjulia")
+        lines = subprocess.run(
+            [sys.executable, "-c", probe, scratch], capture_output=True, text=True, check=True, env=environment
+        ).stdout.splitlines()
+    checks["a copy without _buildinfo.py refuses: %s" % lines[1:]] = (
+        lines[0] == "None" and len(lines) == 2 and "no _buildinfo.py" in lines[1]
+    )
 
     with open(source + "/CHANGELOG.md") as handle:
         changelog = handle.read()

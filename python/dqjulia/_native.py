@@ -40,10 +40,25 @@ try:
 except ImportError:  # running from the source tree, not from a built add-on zip or wheel
     _buildinfo = None  # type: ignore[assignment]
 
+
+def _source_tree_version():
+    """DQJ_VERSION_NUMBER of the source tree this file sits in (python/dqjulia/ under the
+    project's VERSION file), or None: a copy without _buildinfo.py outside the source tree
+    cannot know which library it belongs to, and then refuses to load one."""
+    path = os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))), "VERSION")
+    try:
+        with open(path, encoding="utf-8") as handle:
+            match = re.fullmatch(r"(\d+)\.(\d+)\.(\d+)", handle.read().strip())
+    except OSError:
+        return None
+    return int(match.group(1)) * 10000 + int(match.group(2)) * 100 + int(match.group(3)) if match else None
+
+
 # The C ABI version this copy was built against (DQJ_VERSION_NUMBER = major*10000 +
-# minor*100 + patch, from dqjulia.h at build time). A library loads if its major version is
-# the same and it is not older: minor versions only add functions.
-EXPECTED_VERSION = getattr(_buildinfo, "DQJ_VERSION_NUMBER", 100)
+# minor*100 + patch, from dqjulia.h at build time; in the source tree, from its VERSION file).
+# A library loads if its major version is the same and it is not older: minor versions only add
+# functions. None: this copy cannot tell (no build info, no source tree), so no library loads.
+EXPECTED_VERSION = getattr(_buildinfo, "DQJ_VERSION_NUMBER", None) or _source_tree_version()
 # What holds this copy ("the add-on", "the Python package dqjulia") and how a user gets the
 # library back, for the messages below.
 HOST = getattr(_buildinfo, "HOST", "dqjulia")
@@ -392,6 +407,11 @@ def _load():
     version_number.restype = ctypes.c_uint
     version_number.argtypes = []
     found = version_number()
+    if EXPECTED_VERSION is None:
+        raise LibraryUnavailableError(
+            "%s has no _buildinfo.py and is not in dqjulia's source tree, so it cannot tell which library "
+            "version it was written for: %s" % (os.path.dirname(os.path.abspath(__file__)), REINSTALL)
+        )
     if found // 10000 != EXPECTED_VERSION // 10000 or found < EXPECTED_VERSION:
         raise LibraryUnavailableError(
             "the dqjulia library at %s is version %s, but %s needs %s (same major version, not older): "
