@@ -8,7 +8,7 @@ DQJ_ERROR_CANCELLED. Nothing here touches bpy: the worker only fills plain Pytho
 and the operator that owns the job (operators.py) polls it from a modal timer on the main
 thread, shows its progress, and builds Blender objects only when it has succeeded.
 
-Typed (scripts/check-style.sh runs mypy on it, for Python 3.9 as Blender 3.4's 3.10 needs).
+Typed (scripts/check-style.sh runs mypy on it, for Python 3.9 as native.py; Blender's Pythons are newer).
 """
 
 from __future__ import annotations
