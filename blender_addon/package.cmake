@@ -17,7 +17,7 @@ file(COPY "${SOURCE}/" DESTINATION "${STAGE}/dqjulia"
 file(COPY "${BUILDINFO}" DESTINATION "${STAGE}/dqjulia")
 file(COPY_FILE "${NATIVE}" "${STAGE}/dqjulia/native.py")
 # The project's version (VERSION) into the manifest (4.2+) and bl_info (3.4 - 4.1), which Blender
-# reads as literals without running the add-on. tests/version_test.py checks the zip's.
+# reads as literals without running the add-on. tests/version/version_test.py checks the zip's.
 string(REPLACE "." ", " version_tuple "${VERSION}")
 file(READ "${STAGE}/dqjulia/blender_manifest.toml" text)
 string(REGEX REPLACE "\nversion = \"[0-9.]+\"" "\nversion = \"${VERSION}\"" text "${text}")

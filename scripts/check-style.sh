@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Checks the code against the project's style: clang-format (.clang-format) on C and C++,
-# ruff (ruff.toml: lint and format) on the Python of blender_addon/, python/, scripts/ and tests/, and
-# clang-tidy (.clang-tidy) on C and C++ sources with build/compile_commands.json.
+# ruff (ruff.toml: lint and format) on the Python of blender_addon/, python/, scripts/ and tests/,
+# mypy (mypy.ini) on the typed modules, and clang-tidy (.clang-tidy) on C and C++ sources with
+# build/compile_commands.json.
 #
 #   scripts/check-style.sh          the lines changed since the base: what a commit must keep clean
 #   scripts/check-style.sh --all    every file, every line (the tree is not reformatted yet)
@@ -9,10 +10,11 @@
 #
 # The base is $DQJ_STYLE_BASE, else the merge-base of HEAD with main, or HEAD~1 when HEAD is
 # main itself or there is no main; changes not committed yet count too. ruff's lint and
-# clang-tidy report only findings on changed lines, so old code does not block new.
-# Tools: clang-format and clang-tidy from Debian (scripts/install-deps.sh), ruff from
-# scripts/tool-env.sh ruff; DQJ_CLANG_FORMAT, DQJ_CLANG_TIDY, DQJ_RUFF name others, DQJ_BUILD_DIR
-# another build tree. A missing tool is reported and skipped (DQJ_TEST_SKIPPED, as the tests
+# clang-tidy report only findings on changed lines, so old code does not block new; mypy checks
+# the typed modules whole, every run (a type crosses lines and files).
+# Tools: clang-format and clang-tidy from Debian (scripts/install-deps.sh), ruff and mypy from
+# scripts/tool-env.sh; DQJ_CLANG_FORMAT, DQJ_CLANG_TIDY, DQJ_RUFF, DQJ_MYPY name others,
+# DQJ_BUILD_DIR another build tree. A missing tool is reported and skipped (DQJ_TEST_SKIPPED, as the tests
 # say it), except under CI=true, where it fails.
 # Exit status: 0 clean, 1 findings (or a missing tool in CI), 2 usage.
 set -euo pipefail
@@ -29,6 +31,7 @@ esac
 clang_format="${DQJ_CLANG_FORMAT:-clang-format}"
 clang_tidy="${DQJ_CLANG_TIDY:-clang-tidy}"
 ruff="${DQJ_RUFF:-$(scripts/tool-env.sh ruff --print || true)}"
+mypy="${DQJ_MYPY:-$(scripts/tool-env.sh mypy --print || true)}"
 build="${DQJ_BUILD_DIR:-build}"
 jobs="$(nproc)"
 
@@ -156,6 +159,29 @@ if [ ${#python[@]} -gt 0 ]; then
         done
       done
     fi
+  fi
+fi
+
+# mypy: the typed modules (mypy.ini says which and why), checked as the add-on's package holds
+# them: its modules with native.py, the copy the packaging makes of python/dqjulia/_native.py
+# (blender_addon/package.cmake), in a staging folder; findings name the files of the tree.
+typed=(native.py jobs.py)
+if [ "$mode" != fix ]; then
+  if [ -z "$mypy" ] || ! have "$mypy"; then
+    missing "mypy is not installed (scripts/tool-env.sh mypy installs it)"
+  else
+    stage="$(mktemp -d)"
+    mkdir "$stage/dqjulia"
+    cp blender_addon/dqjulia/*.py "$stage/dqjulia/"
+    cp python/dqjulia/_native.py "$stage/dqjulia/native.py"
+    if ! (cd "$stage" && "$mypy" --config-file "$OLDPWD/mypy.ini" --cache-dir /dev/null "${typed[@]/#/dqjulia/}") \
+      >"$stage/report" 2>&1; then
+      sed -e 's|^dqjulia/native\.py:|python/dqjulia/_native.py:|' -e 's|^dqjulia/|blender_addon/dqjulia/|' "$stage/report"
+      failed=1
+    else
+      echo "check-style: mypy: ${typed[*]} clean"
+    fi
+    rm -rf "$stage"
   fi
 fi
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Sets the project's one version: writes VERSION, and the literal copies that must be readable
 # without a build (the POV-Ray include, used from the source tree; the add-on's manifest and
-# bl_info, which the build rewrites from VERSION anyway). tests/version_test.py holds them equal.
+# bl_info, which the build rewrites from VERSION anyway). tests/version/version_test.py holds them equal.
 # Usage: scripts/set-version.sh MAJOR.MINOR.PATCH
 set -euo pipefail
 cd "$(dirname "$0")/.."

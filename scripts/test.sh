@@ -13,7 +13,7 @@ scripts/install-deps.sh
 # them, so it waits for both.
 venvs_log="$(mktemp)"
 trap 'rm -f "$venvs_log"' EXIT
-(scripts/bpy-env.sh && scripts/tool-env.sh ruff && scripts/tool-env.sh openjd && scripts/tool-env.sh twine && scripts/tool-env.sh auditwheel) >"$venvs_log" 2>&1 &
+(scripts/bpy-env.sh && scripts/tool-env.sh ruff && scripts/tool-env.sh mypy && scripts/tool-env.sh openjd && scripts/tool-env.sh twine && scripts/tool-env.sh auditwheel) >"$venvs_log" 2>&1 &
 venvs=$!
 scripts/build-deps.sh >/dev/null
 if ! wait "$venvs"; then

@@ -2,6 +2,8 @@
 # A pinned command-line tool from PyPI in a virtual environment cached outside the checkout, in
 # ${XDG_CACHE_HOME:-$HOME/.cache}/dqjulia/<tool>/<version> (or $DQJ_RUFF_CACHE, $DQJ_OPENJD_CACHE, ...):
 #   ruff        the Python linter and formatter of scripts/check-style.sh (about 15 MB)
+#   mypy        the type checker of scripts/check-style.sh (mypy.ini; about 90 MB): 1.20, the last
+#               that checks code for Python 3.9, which the Python package and native.py support
 #   openjd      Open Job Description's reference runner for tests/farm (openjd-cli, about 20 MB)
 #   auditwheel  PyPA's checker of a Linux wheel's platform tag, for tests/python (about 10 MB)
 #   twine       PyPA's uploader, whose `twine check` tests/python runs on the wheels and the sdist (about 15 MB)
@@ -14,12 +16,13 @@
 # `TOOL --version` fails is made again.
 set -euo pipefail
 
-usage() { echo "usage: tool-env.sh ruff|openjd|auditwheel|twine [--print]" >&2; exit 2; }
+usage() { echo "usage: tool-env.sh ruff|mypy|openjd|auditwheel|twine [--print]" >&2; exit 2; }
 [ $# -ge 1 ] || usage
 tool="$1"
 shift
 case "$tool" in
   ruff) version=0.17.5 package="ruff==$version" cache="${DQJ_RUFF_CACHE:-}" ;;
+  mypy) version=1.20.2 package="mypy==$version" cache="${DQJ_MYPY_CACHE:-}" ;;
   openjd) version=0.8.0 package="openjd-cli==$version" cache="${DQJ_OPENJD_CACHE:-}" ;;
   auditwheel) version=6.8.2 package="auditwheel==$version" cache="${DQJ_AUDITWHEEL_CACHE:-}" ;;
   twine) version=6.2.0 package="twine==$version" cache="${DQJ_TWINE_CACHE:-}" ;;

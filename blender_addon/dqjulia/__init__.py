@@ -4,7 +4,8 @@ OpenVDB volumes and meshes, and an OSL volume, all computed by the dqjulia core 
 Layout (one idea a module): native.py (ctypes bindings of the C ABI: the Python package's
 python/dqjulia/_native.py, which the build copies into the zip), props.py (the
 parameters on the object and the parameter file's JSON), slicing.py (the slice's 8-D axes),
-animation.py (keyframes), preview.py (the GLSL preview), jobs.py (work in a thread),
+animation.py (keyframes), core_state.py (what the core says about each object's parameters:
+the state the other modules share), preview.py (the GLSL preview), jobs.py (work in a thread),
 bakes.py (cache folder, objects from bakes), operators.py, farm.py (farm tasks' bakes), panels.py,
 osl.py, shaders/.
 """
@@ -23,7 +24,7 @@ bl_info = {
 import bpy
 from bpy.props import StringProperty
 
-from . import bakes, farm, jobs, native, operators, osl, panels, preview, props
+from . import bakes, core_state, farm, jobs, native, operators, osl, panels, preview, props
 
 
 class DQJuliaPreferences(bpy.types.AddonPreferences):
@@ -68,6 +69,7 @@ class DQJuliaPreferences(bpy.types.AddonPreferences):
 def register():
     bpy.utils.register_class(DQJuliaPreferences)
     props.register()
+    core_state.register()
     operators.register()
     farm.register()
     panels.register()
@@ -86,5 +88,6 @@ def unregister():
     panels.unregister()
     farm.unregister()
     operators.unregister()
+    core_state.unregister()
     props.unregister()
     bpy.utils.unregister_class(DQJuliaPreferences)

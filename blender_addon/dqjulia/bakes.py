@@ -24,7 +24,7 @@ import uuid
 import bpy
 from bpy.app.handlers import persistent
 
-from . import preview
+from . import core_state
 
 ADDON_DIR = os.path.dirname(os.path.abspath(__file__))
 BAKE_KIND = "dqjulia_bake"  # custom property on baked objects: "volume", "mesh", "sequence"
@@ -193,7 +193,7 @@ def volume_density(source):
     is 0..1; this makes light fall to e^-4 within bake.color_depth of the bake's side."""
     s = source.dqjulia
     if s.bake_bounds_auto:
-        bounds = preview.state_for(source).bounds
+        bounds = core_state.state_for(source).bounds
         side = 2.0 * (bounds[1] if bounds else 1.0)
     else:
         side = max(high - low for low, high in zip(s.bake_bounds_min, s.bake_bounds_max))

@@ -7,16 +7,22 @@ fraction and returns 1 once cancel() was asked, and the call then ends with
 DQJ_ERROR_CANCELLED. Nothing here touches bpy: the worker only fills plain Python objects,
 and the operator that owns the job (operators.py) polls it from a modal timer on the main
 thread, shows its progress, and builds Blender objects only when it has succeeded.
+
+Typed (scripts/check-style.sh runs mypy on it, for Python 3.9 as native.py; Blender's Pythons are newer).
 """
 
+from __future__ import annotations
+
 import array
+import ctypes
 import os
 import threading
 import time
+from typing import Any, Dict, List, Optional, Sequence, Union
 
 from . import native
 
-_active = []  # running jobs, for the panels
+_active: List[Job] = []  # running jobs, for the panels
 _lock = threading.Lock()
 
 
@@ -24,7 +30,14 @@ class MeshData:
     """A mesh copied out of the core: flat arrays ready for foreach_set (no bpy). Faces as the
     core made them: quads first, then triangles."""
 
-    def __init__(self, positions, normals, colors, quads, triangles):
+    def __init__(
+        self,
+        positions: array.array[float],
+        normals: array.array[float],
+        colors: Optional[array.array[float]],
+        quads: array.array[int],
+        triangles: array.array[int],
+    ) -> None:
         self.positions = positions  # array('f'), 3 a vertex
         self.normals = normals  # array('f'), 3 a vertex
         self.colors = colors  # array('f'), 3 a vertex, or None
@@ -32,24 +45,24 @@ class MeshData:
         self.triangles = triangles  # array('i'), 3 a triangle
 
     @property
-    def vertex_count(self):
+    def vertex_count(self) -> int:
         return len(self.positions) // 3
 
     @property
-    def quad_count(self):
+    def quad_count(self) -> int:
         return len(self.quads) // 4
 
     @property
-    def triangle_count(self):
+    def triangle_count(self) -> int:
         return len(self.triangles) // 3
 
     @property
-    def face_count(self):
+    def face_count(self) -> int:
         return self.quad_count + self.triangle_count
 
 
-def _as_array(typecode, ctypes_array):
-    result = array.array(typecode)
+def _as_array(typecode: str, ctypes_array: ctypes.Array[Any]) -> array.array[Any]:
+    result: array.array[Any] = array.array(typecode)
     result.frombytes(memoryview(ctypes_array).cast("B"))
     return result
 
@@ -59,13 +72,13 @@ class VolumeTask:
 
     kind = "volume"
 
-    def __init__(self, document, path, frame=None):
+    def __init__(self, document: Dict[str, Any], path: str, frame: Optional[int] = None) -> None:
         self.document = document
         self.path = path
         self.frame = frame
         self.warning = ""
 
-    def run(self, context, progress):
+    def run(self, context: native.Context, progress: native.Progress) -> str:
         directory = os.path.dirname(self.path)
         if directory:
             os.makedirs(directory, exist_ok=True)
@@ -78,12 +91,12 @@ class MeshTask:
 
     kind = "mesh"
 
-    def __init__(self, document, colors=True):
+    def __init__(self, document: Dict[str, Any], colors: bool = True) -> None:
         self.document = document
         self.colors = colors
         self.warning = ""
 
-    def run(self, context, progress):
+    def run(self, context: native.Context, progress: native.Progress) -> MeshData:
         self.warning = context.mesh_compute(progress)
         positions, normals, colors, quads, triangles = context.mesh_faces(colors=self.colors)
         return MeshData(
@@ -95,7 +108,11 @@ class MeshTask:
         )
 
 
-def format_duration(seconds):
+# One task of a Job: a native call with its document.
+Task = Union[VolumeTask, MeshTask]
+
+
+def format_duration(seconds: float) -> str:
     """12 s, 4 min, 2.5 h."""
     if seconds < 90:
         return "%d s" % max(1, round(seconds))
@@ -104,7 +121,7 @@ def format_duration(seconds):
     return "%.1f h" % (seconds / 3600.0)
 
 
-def format_bytes(count):
+def format_bytes(count: float) -> str:
     for unit in ("bytes", "KB", "MB", "GB"):
         if count < 1000 or unit == "GB":
             return ("%d %s" if unit == "bytes" else "%.1f %s") % (count, unit)
@@ -117,34 +134,34 @@ class Job:
 
     RUNNING, DONE, FAILED, CANCELLED = "running", "done", "failed", "cancelled"
 
-    def __init__(self, label, tasks, owner=""):
+    def __init__(self, label: str, tasks: Sequence[Task], owner: str = "") -> None:
         self.label = label
         self.owner = owner  # the object's name, for the panel
         self.tasks = list(tasks)
-        self.results = []
+        self.results: List[Union[str, MeshData]] = []  # each task's: a VDB file's path, a mesh
         self.state = Job.RUNNING
         self.error = ""
-        self.warnings = []
+        self.warnings: List[str] = []
         self.index = 0  # the task under way
         self._task_fraction = 0.0
-        self._progress = None
+        self._progress: Optional[native.Progress] = None
         self._cancel = threading.Event()
-        self._thread = None
+        self._thread: Optional[threading.Thread] = None
         self.started = time.monotonic()
-        self.finished = None
+        self.finished: Optional[float] = None
 
     # progress ------------------------------------------------------------------------------
 
     @property
-    def fraction(self):
+    def fraction(self) -> float:
         if not self.tasks:
             return 1.0
         return min(1.0, (self.index + self._task_fraction) / len(self.tasks))
 
-    def _on_progress(self, fraction):
+    def _on_progress(self, fraction: float) -> None:
         self._task_fraction = fraction
 
-    def status_text(self):
+    def status_text(self) -> str:
         """ "Bake sequence: 12 of 250 frames done, 4% (about 23 min left)"."""
         text = "%s: %d%%" % (self.label, round(100.0 * self.fraction))
         if len(self.tasks) > 1:
@@ -160,7 +177,7 @@ class Job:
             text += " (about %s left)" % format_duration(left)
         return text
 
-    def seconds_left(self):
+    def seconds_left(self) -> Optional[float]:
         """The time left at the pace so far; None until there is a pace to go by."""
         fraction = self.fraction
         elapsed = time.monotonic() - self.started
@@ -170,7 +187,7 @@ class Job:
 
     # control -------------------------------------------------------------------------------
 
-    def cancel(self):
+    def cancel(self) -> None:
         """Asks the work to stop; safe from any thread. The native call returns at its next
         progress report."""
         self._cancel.set()
@@ -179,14 +196,14 @@ class Job:
             progress.cancel()
 
     @property
-    def cancel_requested(self):
+    def cancel_requested(self) -> bool:
         return self._cancel.is_set()
 
     @property
-    def finished_running(self):
+    def finished_running(self) -> bool:
         return self.state != Job.RUNNING
 
-    def run(self):
+    def run(self) -> str:
         """Runs every task in the calling thread (the worker, or the main thread for scripts)."""
         try:
             context = native.Context()
@@ -231,14 +248,14 @@ class Job:
             self.finished = time.monotonic()
         return self.state
 
-    def start(self):
+    def start(self) -> None:
         """Runs the tasks in a worker thread; poll finished_running from the main thread."""
         with _lock:
             _active.append(self)
         self._thread = threading.Thread(target=self._thread_main, name="dqjulia-" + self.label, daemon=True)
         self._thread.start()
 
-    def _thread_main(self):
+    def _thread_main(self) -> None:
         try:
             self.run()
         finally:
@@ -246,16 +263,16 @@ class Job:
                 if self in _active:
                     _active.remove(self)
 
-    def join(self, timeout=None):
+    def join(self, timeout: Optional[float] = None) -> None:
         if self._thread is not None:
             self._thread.join(timeout)
 
 
-def active_jobs(owner=None):
+def active_jobs(owner: Optional[str] = None) -> List[Job]:
     with _lock:
         return [job for job in _active if owner is None or job.owner == owner]
 
 
-def cancel_all():
+def cancel_all() -> None:
     for job in active_jobs():
         job.cancel()

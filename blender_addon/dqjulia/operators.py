@@ -17,7 +17,7 @@ import bpy
 from bpy.props import BoolProperty, EnumProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
-from . import animation, bakes, jobs, native, osl, preview, props
+from . import animation, bakes, core_state, jobs, native, osl, props
 
 PRESET_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "presets")
 
@@ -154,7 +154,7 @@ class DQJULIA_OT_add(bpy.types.Operator):
             bpy.data.objects.remove(obj)
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        state = preview.state_for(obj)
+        state = core_state.state_for(obj)
         if state.bounds is not None:
             obj.empty_display_size = state.bounds[1]
         for other in context.selected_objects:

@@ -10,7 +10,7 @@ import os
 import bpy
 from bpy.app.handlers import persistent
 
-from . import bakes, preview
+from . import bakes, core_state
 
 SCRIPT_PATH = os.path.join(os.path.dirname(os.path.abspath(__file__)), "shaders", "dqjulia_density.osl")
 TEXT_NAME = "dqjulia_density.osl"
@@ -41,7 +41,7 @@ def shader_text():
 
 def input_values(obj):
     """The Script node's input values for the object's current parameters."""
-    state = preview.state_for(obj)
+    state = core_state.state_for(obj)
     if state.error:
         raise RuntimeError(state.error)
     if state.bounds is None:

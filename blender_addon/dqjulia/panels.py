@@ -8,7 +8,7 @@ import time
 
 import bpy
 
-from . import bakes, jobs, native, operators, osl, preview, props
+from . import bakes, core_state, jobs, native, operators, osl, preview, props
 
 
 def _wrapped(layout, text, icon="NONE", alert=False, width=None):
@@ -127,7 +127,7 @@ class _MainPanel:
         column.label(text="Constant c = a + b\u03b5:")
         _constant(column, context, s)
 
-        state = preview.state_for(obj)
+        state = core_state.state_for(obj)
         if state.error:
             box = layout.box()
             _wrapped(box, state.error, icon="ERROR", alert=True)
@@ -197,7 +197,7 @@ class _BoundsPanel(_Base):
         column.enabled = not s.bounds_auto
         column.prop(s, "bounds_center")
         column.prop(s, "bounds_radius")
-        state = preview.state_for(obj)
+        state = core_state.state_for(obj)
         if state.bounds:
             center, radius, clipped = state.bounds
             layout.label(

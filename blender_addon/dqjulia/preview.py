@@ -5,31 +5,26 @@ The shader is shaders/dqjulia_de.glsl (the DE and sphere tracer) and shaders/dqj
 (the core's colouring and Phong terms, coloring.hpp), the code the test suite compiles as C++
 and compares with the core, followed by shaders/preview_frag.glsl; its interface is
 shaders/preview.interface. What the shader cannot compute cheaply comes from the
-core, once per change of parameters (`state_for`): validation of the document, the bounds,
-whether the slice is provably empty (and why), and r_K; slicing.py turns the slice's rotations
-into the 8-D axes. Marching costs one ray per pixel of the cube around the bounds; the
-result is kept per viewport in textures (colour and depth) and put back by a blit shader
-(shaders/blit_*) until the view or a previewed object changes, so Blender's many other
-redraws of the viewport stay cheap.
+core, once per change of parameters (core_state.py's `state_for`): validation of the document,
+the bounds, whether the slice is provably empty (and why), r_K and the slice's 8-D axes.
+Marching costs one ray per pixel of the cube around the bounds; the result is kept per viewport
+in textures (colour and depth) and put back by a blit shader (shaders/blit_*) until the view or
+a previewed object changes, so Blender's many other redraws of the viewport stay cheap.
 """
 
 import ctypes
-import json
 import math
 import os
 
 import bpy
 
-from . import native, props, slicing
+from . import core_state, native
 
 SHADER_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "shaders")
 
 _shader = None
 _shader_error = None
 _handler = None
-_states = {}  # document JSON -> State
-_MAX_STATES = 64
-_context = None  # the main thread's native context for validation and inspection
 draw_count = 0  # previews drawn by the draw handler (tests read it)
 
 
@@ -121,80 +116,6 @@ def blit_shader():
 
 def shader_error():
     return _shader_error
-
-
-# -------------------------------------------------------------------------------------------
-# What the shader needs, from the core
-
-
-class State:
-    """The validated parameters of one document and what the preview derives from them."""
-
-    def __init__(self, document, text):
-        self.document = document
-        self.text = text
-        self.error = None  # the core's validation message, or why the library is unusable
-        self.empty_reason = ""  # why nothing can be seen (slice proven empty, bounds missing)
-        self.inspect = None
-        self.bounds = None  # (center, radius, clipped)
-        self.origin = None
-        self.axes = None
-        self.stretch = 1.0
-        self.containment_radius = 1.0
-
-    @property
-    def drawable(self):
-        return self.error is None and not self.empty_reason and self.bounds is not None
-
-
-def _native_context():
-    global _context
-    if _context is None:
-        _context = native.Context()
-    return _context
-
-
-def state_for_document(document):
-    text = json.dumps(document, sort_keys=True)
-    state = _states.get(text)
-    if state is not None:
-        return state
-    state = State(document, text)
-    try:
-        context = _native_context()
-        context.set_params(document)
-        state.inspect = context.inspect()
-        bounds = state.inspect.get("bounds")
-        if state.inspect.get("empty"):
-            state.empty_reason = state.inspect.get("empty_reason") or "the slice is empty"
-        if bounds is None:
-            state.empty_reason = state.empty_reason or "the slice misses the containment region"
-        else:
-            state.bounds = (tuple(bounds["center"]), float(bounds["radius"]), bool(bounds.get("clipped")))
-        state.containment_radius = float(state.inspect["real"]["containment_radius"])
-        state.origin, state.axes = slicing.effective_slice(document)
-        state.stretch = slicing.stretch(state.axes)[0]
-    except native.NativeUnavailable as error:
-        state.error = str(error)
-    except native.NativeError as error:
-        state.error = error.message
-    if len(_states) >= _MAX_STATES:
-        _states.clear()
-    _states[text] = state
-    return state
-
-
-def state_for(obj):
-    """The State of an object's current parameters (cached by document)."""
-    return state_for_document(props.to_document(obj.dqjulia))
-
-
-def clear_cache():
-    global _context
-    _states.clear()
-    if _context is not None:
-        _context.close()
-        _context = None
 
 
 # -------------------------------------------------------------------------------------------
@@ -338,7 +259,7 @@ def draw_object(obj, view_matrix, projection_matrix, viewport_height):
     import gpu
     from gpu_extras.batch import batch_for_shader
 
-    state = state_for(obj)
+    state = core_state.state_for(obj)
     if not state.drawable:
         return False
     program = shader()
@@ -394,7 +315,7 @@ def draw_outline(obj, colour):
     import gpu
     from gpu_extras.batch import batch_for_shader
 
-    state = state_for(obj)
+    state = core_state.state_for(obj)
     if state.bounds is None:
         return
     program = _uniform_color_shader()
@@ -471,7 +392,7 @@ def draw_cached(region_key, objects, view, projection, width, height):
     # the preview does not show, such as the bake resolution, keeps the cache).
     key = [cache_width, cache_height]
     for obj in objects:
-        push, params, mirrored = uniforms(obj, state_for(obj), view, projection, cache_height)
+        push, params, mirrored = uniforms(obj, core_state.state_for(obj), view, projection, cache_height)
         key += [bytes(params), mirrored] + [
             _matrix_key(value) if hasattr(value, "row") else tuple(value) for value in push.values()
         ]
@@ -518,7 +439,7 @@ def _draw_handler():
     _x, _y, width, height = gpu.state.viewport_get()
     objects = list(preview_objects(context))
     try:
-        shown = [obj for obj in objects if obj.dqjulia.show_preview and state_for(obj).drawable]
+        shown = [obj for obj in objects if obj.dqjulia.show_preview and core_state.state_for(obj).drawable]
         if shown:
             region = context.region
             draw_cached(region.as_pointer() if region else 0, shown, view, projection, width, height)
@@ -535,7 +456,6 @@ def _draw_handler():
 def _forget_views(*_args):
     """A file was loaded: its viewports are new, drop the old ones' cached pictures."""
     _view_caches.clear()
-    _states.clear()
 
 
 def register():
@@ -557,4 +477,3 @@ def unregister():
     _blit_shader = None
     _shader_error = None
     _view_caches.clear()
-    clear_cache()

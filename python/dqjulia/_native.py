@@ -26,7 +26,12 @@ StatusError and LibraryUnavailableError.
 No bpy and no NumPy here: the module is used from Blender's worker threads (ctypes releases the
 GIL during each call), by the package and by the tests. Buffers are passed as ctypes objects or
 pointers (the *_into methods), so callers can hand in NumPy arrays without a copy.
+
+Typed (scripts/check-style.sh runs mypy on it, for Python 3.9): annotations are not evaluated at
+run time (`from __future__ import annotations`), so they may use what 3.9 cannot evaluate.
 """
+
+from __future__ import annotations
 
 import ctypes
 import json
@@ -34,14 +39,25 @@ import os
 import re
 import sys
 import threading
+from types import ModuleType
+from typing import Any, Callable, Dict, FrozenSet, Iterable, List, Optional, Sequence, Tuple, Type, Union
 
+_buildinfo: Optional[ModuleType]
 try:
-    from . import _buildinfo
+    from . import _buildinfo  # type: ignore[attr-defined, no-redef, unused-ignore]
 except ImportError:  # running from the source tree, not from a built add-on zip or wheel
-    _buildinfo = None  # type: ignore[assignment]
+    _buildinfo = None
+
+# A parameter document: a dict as the core's JSON, or that JSON's text.
+Document = Union[Dict[str, Any], str]
+# A buffer the caller hands in: a ctypes array or pointer of the right element type (a NumPy
+# array's `ctypes.data_as(...)`), or None where the C function takes NULL.
+Buffer = Any
+# What a progress callback is told: the fraction done (0 to 1). Its result is not used.
+OnProgress = Callable[[float], object]
 
 
-def _source_tree_version():
+def _source_tree_version() -> Optional[int]:
     """DQJ_VERSION_NUMBER of the source tree this file sits in (python/dqjulia/ under the
     project's VERSION file), or None: a copy without _buildinfo.py outside the source tree
     cannot know which library it belongs to, and then refuses to load one."""
@@ -58,11 +74,11 @@ def _source_tree_version():
 # minor*100 + patch, from dqjulia.h at build time; in the source tree, from its VERSION file).
 # A library loads if its major version is the same and it is not older: minor versions only add
 # functions. None: this copy cannot tell (no build info, no source tree), so no library loads.
-EXPECTED_VERSION = getattr(_buildinfo, "DQJ_VERSION_NUMBER", None) or _source_tree_version()
+EXPECTED_VERSION: Optional[int] = getattr(_buildinfo, "DQJ_VERSION_NUMBER", None) or _source_tree_version()
 # What holds this copy ("the add-on", "the Python package dqjulia") and how a user gets the
 # library back, for the messages below.
-HOST = getattr(_buildinfo, "HOST", "dqjulia")
-REINSTALL = getattr(_buildinfo, "REINSTALL", "reinstall dqjulia")
+HOST: str = getattr(_buildinfo, "HOST", "dqjulia")
+REINSTALL: str = getattr(_buildinfo, "REINSTALL", "reinstall dqjulia")
 
 LIBRARY_ENV = "DQJULIA_LIBRARY"  # developers: load this file instead of the bundled one
 
@@ -104,13 +120,13 @@ class StatusError(DqjuliaError):
     """A call returned a dqj_status other than DQJ_OK: `status` (the code), `message` (the
     library's own text, naming the key or file at fault)."""
 
-    def __init__(self, status, message):
+    def __init__(self, status: int, message: str) -> None:
         self.status = status
         self.message = message
         super().__init__(message)
 
     @property
-    def cancelled(self):
+    def cancelled(self) -> bool:
         return self.status == ERROR_CANCELLED
 
 
@@ -149,7 +165,7 @@ class BusyError(StatusError):
 
 
 # dqj_status -> the class raised for it.
-ERROR_CLASSES = {
+ERROR_CLASSES: Dict[int, Type[StatusError]] = {
     ERROR_INVALID_HANDLE: InvalidHandleError,
     ERROR_INVALID_ARGUMENT: InvalidArgumentError,
     ERROR_PARAMETERS: ParameterError,
@@ -161,7 +177,7 @@ ERROR_CLASSES = {
 }
 
 
-def error_for(status, message):
+def error_for(status: int, message: str) -> StatusError:
     """The exception for a status: its class of ERROR_CLASSES (StatusError for an unknown one)."""
     return ERROR_CLASSES.get(status, StatusError)(status, message)
 
@@ -209,7 +225,7 @@ _BAKE = (FEATURE_VDB, FEATURE_MESH)  # the calls bakes and meshes share
 
 # name: (restype, argtypes, features): None for a function every library has, else the
 # features of which any one brings it.
-_SIGNATURES = {
+_SIGNATURES: Dict[str, Tuple[Any, List[Any], Optional[Tuple[str, ...]]]] = {
     "dqj_version_number": (ctypes.c_uint, [], None),
     "dqj_version_string": (ctypes.c_char_p, [], None),
     "dqj_status_string": (ctypes.c_char_p, [ctypes.c_int], None),
@@ -283,15 +299,15 @@ _SIGNATURES = {
 }
 
 _lock = threading.Lock()
-_library = None
-_load_error = None
-_library_path = None
-_dll_directory = None  # Windows: the library's folder, added to the DLL search path while loaded
-_features: "frozenset[str]" = frozenset()  # the FEATURES the loaded library has
-_bound: "frozenset[str]" = frozenset()  # the functions of _SIGNATURES it offers
+_library: Optional[ctypes.CDLL] = None
+_load_error: Optional[str] = None
+_library_path: Optional[str] = None
+_dll_directory: Optional[object] = None  # Windows: the library's folder, added to the DLL search path while loaded
+_features: FrozenSet[str] = frozenset()  # the FEATURES the loaded library has
+_bound: FrozenSet[str] = frozenset()  # the functions of _SIGNATURES it offers
 
 
-def version_text(number):
+def version_text(number: int) -> str:
     return "%d.%d.%d" % (number // 10000, number // 100 % 100, number % 100)
 
 
@@ -303,7 +319,7 @@ _REQUIREMENTS = {
 }
 
 
-def platform_problem():
+def platform_problem() -> Optional[str]:
     """None when this system can run dqjulia's native code as far as can be told without loading
     it, else why not in plain words. On Linux: the C library must be glibc at GLIBC_FLOOR or newer
     (asked with os.confstr, so nothing is loaded that would fail with a loader error)."""
@@ -328,7 +344,7 @@ def platform_problem():
     return None
 
 
-def bundled_file(folder, tree_folder, name):
+def bundled_file(folder: str, tree_folder: str, name: str) -> str:
     """A native file shipped with this code: FOLDER/NAME beside this file, where the add-on zip and
     the wheel put it. The package's modules alone in an install tree, as
     <prefix>/lib/python/dqjulia, use the tree's own file instead: <prefix>/TREE_FOLDER/NAME."""
@@ -341,7 +357,7 @@ def bundled_file(folder, tree_folder, name):
     return in_tree if os.path.isfile(in_tree) else beside
 
 
-def bundled_library_path():
+def bundled_library_path() -> str:
     """Where the library is: lib/ beside this file (the one made for this platform), or an install
     tree's lib/libdqjulia.so or bin/dqjulia.dll (bundled_file)."""
     if sys.platform == "win32":
@@ -349,15 +365,15 @@ def bundled_library_path():
     return bundled_file("lib", "lib", {"darwin": "libdqjulia.dylib"}.get(sys.platform, "libdqjulia.so"))
 
 
-def library_path():
+def library_path() -> str:
     return os.environ.get(LIBRARY_ENV) or bundled_library_path()
 
 
-def _bind(library):
+def _bind(library: ctypes.CDLL) -> Tuple[FrozenSet[str], FrozenSet[str]]:
     """Declares the functions the library offers: every required one, and those of the
     optional features it says it has. Returns (features, function names)."""
 
-    def declare(name, restype, argtypes):
+    def declare(name: str, restype: Any, argtypes: List[Any]) -> None:
         try:
             function = getattr(library, name)
         except AttributeError:
@@ -371,7 +387,7 @@ def _bind(library):
     restype, argtypes, _ = _SIGNATURES["dqj_has_feature"]
     declare("dqj_has_feature", restype, argtypes)
     features = frozenset(name for name in FEATURES if library.dqj_has_feature(name.encode()) == 1)
-    bound = set()
+    bound: set[str] = set()
     for name, (restype, argtypes, needs) in _SIGNATURES.items():
         if needs is None or features.intersection(needs):
             declare(name, restype, argtypes)
@@ -379,7 +395,7 @@ def _bind(library):
     return features, frozenset(bound)
 
 
-def _load():
+def _load() -> Tuple[ctypes.CDLL, Tuple[FrozenSet[str], FrozenSet[str]]]:
     global _library_path, _dll_directory
     path = library_path()
     _library_path = path
@@ -406,7 +422,7 @@ def _load():
         raise LibraryUnavailableError("%s is not the dqjulia library (no dqj_version_number)" % path) from None
     version_number.restype = ctypes.c_uint
     version_number.argtypes = []
-    found = version_number()
+    found: int = version_number()
     if EXPECTED_VERSION is None:
         raise LibraryUnavailableError(
             "%s has no _buildinfo.py and is not in dqjulia's source tree, so it cannot tell which library "
@@ -421,7 +437,7 @@ def _load():
     return library, _bind(library)
 
 
-def library():
+def library() -> ctypes.CDLL:
     """The loaded library; raises LibraryUnavailableError (with the reason) if it cannot be used."""
     global _library, _load_error, _features, _bound
     with _lock:
@@ -435,7 +451,7 @@ def library():
         return _library
 
 
-def load_error():
+def load_error() -> Optional[str]:
     """None when the library is usable, else why not (for the UI)."""
     try:
         library()
@@ -444,7 +460,7 @@ def load_error():
         return str(error)
 
 
-def reset():
+def reset() -> None:
     """Forget the loaded library and the last error, so the next use tries again (tests)."""
     global _library, _load_error, _features, _bound
     with _lock:
@@ -454,7 +470,7 @@ def reset():
         _bound = frozenset()
 
 
-def has_feature(name):
+def has_feature(name: str) -> bool:
     """Whether the loaded library has this optional feature (FEATURE_*; False if it cannot be
     loaded or this copy does not know the name)."""
     try:
@@ -464,7 +480,7 @@ def has_feature(name):
     return name in _features
 
 
-def has(name):
+def has(name: str) -> bool:
     """Whether the loaded library offers this function of _SIGNATURES (False if it cannot be
     loaded)."""
     try:
@@ -474,24 +490,27 @@ def has(name):
     return name in _bound
 
 
-def version():
+def version() -> Tuple[int, str]:
     """(number, text) of the loaded library."""
     lib = library()
-    return lib.dqj_version_number(), lib.dqj_version_string().decode()
+    text: bytes = lib.dqj_version_string()
+    return int(lib.dqj_version_number()), text.decode()
 
 
-def status_text(status):
-    return library().dqj_status_string(status).decode()
+def status_text(status: int) -> str:
+    text: bytes = library().dqj_status_string(status)
+    return text.decode()
 
 
-def _function(name):
+def _function(name: str) -> Callable[..., Any]:
     lib = library()
     if name not in _bound:
         raise LibraryUnavailableError(
             "the dqjulia library %s has no %s (it lacks the feature %s); %s needs a library that has it"
             % (version()[1], name, " or ".join(_SIGNATURES[name][2] or ()) if name in _SIGNATURES else "?", HOST)
         )
-    return getattr(lib, name)
+    function: Callable[..., Any] = getattr(lib, name)
+    return function
 
 
 class Progress:
@@ -507,15 +526,15 @@ class Progress:
     `raise_error()` once the native call has returned. Otherwise it is ignored and the work goes on.
     """
 
-    def __init__(self, on_progress=None, cancel_on_error=False):
+    def __init__(self, on_progress: Optional[OnProgress] = None, cancel_on_error: bool = False) -> None:
         self.fraction = 0.0
-        self.error = None
+        self.error: Optional[BaseException] = None
         self._cancel = threading.Event()
         self._on_progress = on_progress
         self._cancel_on_error = cancel_on_error
         self.callback = PROGRESS_FN(self._report)
 
-    def _report(self, fraction, _user):
+    def _report(self, fraction: float, _user: Optional[int]) -> int:
         try:
             self.fraction = max(0.0, min(1.0, float(fraction)))
             if self._on_progress is not None:
@@ -526,38 +545,55 @@ class Progress:
                 self._cancel.set()
         return 0 if self._cancel.is_set() else 1  # dqj_progress_fn: non-zero goes on, 0 cancels
 
-    def cancel(self):
+    def cancel(self) -> None:
         self._cancel.set()
 
     @property
-    def cancelled(self):
+    def cancelled(self) -> bool:
         return self._cancel.is_set()
 
-    def raise_error(self):
+    def raise_error(self) -> None:
         """Raises the exception the callback kept, if any (after the native call returned)."""
         if self.error is not None:
             error, self.error = self.error, None
             raise error
 
 
-def _text(pointer):
+def _text(pointer: Optional[bytes]) -> str:
     return pointer.decode("utf-8", "replace") if pointer else ""
+
+
+def _json_object(text: str) -> Dict[str, Any]:
+    """The JSON object of a text the library wrote."""
+    value: Dict[str, Any] = json.loads(text)
+    return value
+
+
+# A mesh's arrays as Context.mesh_faces gives them: positions, normals, colours (or None), quads
+# and triangles.
+MeshFaces = Tuple[
+    "ctypes.Array[ctypes.c_float]",
+    "ctypes.Array[ctypes.c_float]",
+    "Optional[ctypes.Array[ctypes.c_float]]",
+    "ctypes.Array[ctypes.c_uint32]",
+    "ctypes.Array[ctypes.c_uint32]",
+]
 
 
 class Context:
     """A dqj_context: a parameter set and the text of its last error. One thread at a time."""
 
-    def __init__(self, params=None):
+    def __init__(self, params: Optional[Document] = None) -> None:
         self._lib = library()
         handle = _handle()
         status = self._lib.dqj_context_create(ctypes.byref(handle))
         if status != OK:
             raise error_for(status, "dqj_context_create failed: %s" % status_text(status))
-        self._handle = handle
+        self._handle: Optional[ctypes.c_void_p] = handle
         if params is not None:
             self.set_params(params)
 
-    def close(self):
+    def close(self) -> None:
         """Destroys the native context. Raises BusyError if one of its calls is still running,
         e.g. when called from that call's progress callback: cancel instead."""
         if getattr(self, "_handle", None):
@@ -566,36 +602,36 @@ class Context:
                 raise BusyError(status, "the dqjulia context is busy (a call on it is running): cancel it first")
             self._handle = None
 
-    def __del__(self):
+    def __del__(self) -> None:
         try:
             self.close()
         except Exception:
             pass
 
-    def __enter__(self):
+    def __enter__(self) -> Context:
         return self
 
-    def __exit__(self, *exc):
+    def __exit__(self, *exc: object) -> None:
         self.close()
 
     @property
-    def handle(self):
+    def handle(self) -> ctypes.c_void_p:
         if not self._handle:
             raise InvalidHandleError(ERROR_INVALID_HANDLE, "the dqjulia context was closed")
         return self._handle
 
-    def error(self):
+    def error(self) -> str:
         return _text(self._lib.dqj_context_error(self.handle))
 
-    def warning(self):
+    def warning(self) -> str:
         return _text(self._lib.dqj_context_warning(self.handle))
 
-    def check(self, status, what):
+    def check(self, status: int, what: Optional[str]) -> None:
         if status != OK:
             message = self.error() or status_text(status)
             raise error_for(status, "%s: %s" % (what, message) if what else message)
 
-    def _text_out(self, function_name):
+    def _text_out(self, function_name: str) -> str:
         function = _function(function_name)
         size = ctypes.c_size_t(0)
         self.check(function(self.handle, None, 0, ctypes.byref(size)), function_name)
@@ -603,7 +639,7 @@ class Context:
         self.check(function(self.handle, buffer, size.value, ctypes.byref(size)), function_name)
         return buffer.value.decode("utf-8")
 
-    def _run(self, what, function, progress, *arguments):
+    def _run(self, what: str, function: Callable[..., int], progress: Optional[Progress], *arguments: Any) -> str:
         """A call that reports progress: `function(handle, *arguments, callback, None)`. An error
         kept by the callback (an exception in on_progress, Ctrl-C) is raised in place of the
         cancel it caused."""
@@ -615,55 +651,55 @@ class Context:
 
     # Parameters -------------------------------------------------------------------------
 
-    def load_params_file(self, path):
+    def load_params_file(self, path: Union[str, os.PathLike[str]]) -> None:
         self.check(self._lib.dqj_context_load_params_file(self.handle, os.fsencode(path)), None)
 
-    def set_params_json(self, text):
+    def set_params_json(self, text: str) -> None:
         self.check(self._lib.dqj_context_set_params_json(self.handle, text.encode("utf-8")), None)
 
-    def set_params(self, document):
+    def set_params(self, document: Document) -> None:
         """Sets the whole parameter document (a dict or JSON text); the core validates it."""
         self.set_params_json(document if isinstance(document, str) else json.dumps(document))
 
-    def params_json(self):
+    def params_json(self) -> str:
         return self._text_out("dqj_context_get_params_json")
 
-    def params(self):
+    def params(self) -> Dict[str, Any]:
         """The complete parameter document the core holds (every key), as a dict."""
-        return json.loads(self.params_json())
+        return _json_object(self.params_json())
 
-    def schema(self):
+    def schema(self) -> Dict[str, Any]:
         """The parameter schema (dqj_params_schema_json) as a dict: every key's type, label, help,
         default and range. The add-on's props.py builds its properties from the packaged copy
         (schema.json)."""
-        return json.loads(self._text_out("dqj_params_schema_json"))
+        return _json_object(self._text_out("dqj_params_schema_json"))
 
-    def inspect(self):
+    def inspect(self) -> Dict[str, Any]:
         """dqj_inspect_json as a dict: equivalent complex constants, bounds, emptiness and why."""
-        return json.loads(self._text_out("dqj_inspect_json"))
+        return _json_object(self._text_out("dqj_inspect_json"))
 
     # Evaluation -------------------------------------------------------------------------
 
-    def evaluate_points(self, points):
+    def evaluate_points(self, points: Iterable[Sequence[float]]) -> List[Sample]:
         """points: sequence of 8-number sequences. Returns a list of Sample."""
         return self._evaluate(points, 8)
 
-    def evaluate_slice_points(self, points):
+    def evaluate_slice_points(self, points: Iterable[Sequence[float]]) -> List[Sample]:
         """points: sequence of (x, y, z) in the slice. Returns a list of Sample."""
         return self._evaluate(points, 3)
 
-    def _evaluate(self, points, width):
-        points = list(points)
-        flat = (ctypes.c_double * (width * len(points)))()
-        for index, point in enumerate(points):
+    def _evaluate(self, points: Iterable[Sequence[float]], width: int) -> List[Sample]:
+        listed = list(points)
+        flat = (ctypes.c_double * (width * len(listed)))()
+        for index, point in enumerate(listed):
             if len(point) != width:
                 raise ValueError("each point needs %d numbers" % width)
             flat[width * index : width * index + width] = [float(x) for x in point]
-        out = (Sample * max(1, len(points)))()
-        self.evaluate_into(flat, len(points), out, slice_points=width == 3)
-        return list(out[: len(points)])
+        out = (Sample * max(1, len(listed)))()
+        self.evaluate_into(flat, len(listed), out, slice_points=width == 3)
+        return list(out[: len(listed)])
 
-    def evaluate_into(self, points, count, out, slice_points=False):
+    def evaluate_into(self, points: Buffer, count: int, out: Buffer, slice_points: bool = False) -> None:
         """Evaluates `count` points from a buffer of doubles (8 a point, or 3 with slice_points)
         into a buffer of `count` Sample: ctypes arrays or pointers (a NumPy array's
         `ctypes.data_as(...)`), sized by the caller."""
@@ -672,48 +708,50 @@ class Context:
 
     # Rendering --------------------------------------------------------------------------
 
-    def render_rgba8(self, width, height, progress=None):
+    def render_rgba8(self, width: int, height: int, progress: Optional[Progress] = None) -> Tuple[bytes, str]:
         """Renders with the core's renderer; returns (bytes RGBA8 sRGB rows top-down, warning)."""
         stride = 4 * width
         pixels = (ctypes.c_uint8 * (stride * height))()
         warning = self.render_rgba8_into(pixels, width, height, stride, progress)
         return bytes(pixels), warning
 
-    def render_rgba8_into(self, pixels, width, height, stride, progress=None):
+    def render_rgba8_into(
+        self, pixels: Buffer, width: int, height: int, stride: int, progress: Optional[Progress] = None
+    ) -> str:
         """Renders into a caller's buffer of `height` rows of `stride` bytes (a ctypes array or
         pointer); returns the warning ("" if none)."""
         return self._run("render", self._lib.dqj_render_rgba8, progress, pixels, width, height, stride)
 
-    def render_to_file(self, path, progress=None):
+    def render_to_file(self, path: Union[str, os.PathLike[str]], progress: Optional[Progress] = None) -> str:
         return self._run("render", self._lib.dqj_render_to_file, progress, os.fsencode(path))
 
     # Baking -----------------------------------------------------------------------------
 
-    def set_frame(self, frame):
+    def set_frame(self, frame: float) -> None:
         self.check(_function("dqj_context_set_frame")(self.handle, float(frame)), "frame")
 
-    def set_bake_resolution(self, resolution):
+    def set_bake_resolution(self, resolution: int) -> None:
         self.check(_function("dqj_context_set_bake_resolution")(self.handle, int(resolution)), "bake resolution")
 
-    def set_memory_limit(self, limit_bytes):
+    def set_memory_limit(self, limit_bytes: int) -> None:
         self.check(_function("dqj_context_set_memory_limit")(self.handle, int(limit_bytes)), "memory limit")
 
-    def bake_vdb(self, path, progress=None):
+    def bake_vdb(self, path: Union[str, os.PathLike[str]], progress: Optional[Progress] = None) -> str:
         """Writes an OpenVDB file (grids "surface", "density" and bake.grids); all or nothing.
         Returns the context's warning ("" if none)."""
         return self._run("bake", _function("dqj_bake_vdb"), progress, os.fsencode(path))
 
-    def mesh_compute(self, progress=None):
+    def mesh_compute(self, progress: Optional[Progress] = None) -> str:
         return self._run("mesh", _function("dqj_mesh_compute"), progress)
 
-    def mesh_sizes(self):
+    def mesh_sizes(self) -> Tuple[int, int]:
         vertices, triangles = ctypes.c_size_t(0), ctypes.c_size_t(0)
         self.check(
             _function("dqj_mesh_get_sizes")(self.handle, ctypes.byref(vertices), ctypes.byref(triangles)), "mesh sizes"
         )
         return vertices.value, triangles.value
 
-    def mesh_face_counts(self):
+    def mesh_face_counts(self) -> Tuple[int, int]:
         """(quads, triangles) of the context's mesh as the core made it."""
         quads, triangles = ctypes.c_size_t(0), ctypes.c_size_t(0)
         self.check(
@@ -722,7 +760,15 @@ class Context:
         )
         return quads.value, triangles.value
 
-    def mesh_copy_into(self, positions, normals, colors, vertex_capacity, triangles=None, triangle_capacity=0):
+    def mesh_copy_into(
+        self,
+        positions: Buffer,
+        normals: Buffer,
+        colors: Buffer,
+        vertex_capacity: int,
+        triangles: Buffer = None,
+        triangle_capacity: int = 0,
+    ) -> None:
         """dqj_mesh_copy into caller buffers (ctypes arrays or pointers; normals, colors and
         triangles may be None)."""
         function = _function("dqj_mesh_copy")
@@ -731,12 +777,14 @@ class Context:
             "mesh copy",
         )
 
-    def mesh_copy_faces_into(self, quads, quad_capacity, triangles, triangle_capacity):
+    def mesh_copy_faces_into(
+        self, quads: Buffer, quad_capacity: int, triangles: Buffer, triangle_capacity: int
+    ) -> None:
         """dqj_mesh_copy_faces into caller buffers of 4 and 3 uint32 a face."""
         function = _function("dqj_mesh_copy_faces")
         self.check(function(self.handle, quads, quad_capacity, triangles, triangle_capacity), "mesh faces")
 
-    def mesh_faces(self, colors=True):
+    def mesh_faces(self, colors: bool = True) -> MeshFaces:
         """The context's mesh with its faces as the core made them: (positions, normals, colors or
         None, quads, triangles) as ctypes arrays; 4 and 3 uint32 indices a face."""
         vertex_count, _triangle_count = self.mesh_sizes()
@@ -750,10 +798,10 @@ class Context:
         self.mesh_copy_faces_into(quads, quad_count, triangles, triangle_count)
         return positions, normals, colours, quads, triangles
 
-    def mesh_write(self, path):
+    def mesh_write(self, path: Union[str, os.PathLike[str]]) -> None:
         self.check(_function("dqj_mesh_write")(self.handle, os.fsencode(path)), "mesh write")
 
-    def bake_stats(self):
+    def bake_stats(self) -> BakeStats:
         stats = BakeStats(struct_size=ctypes.sizeof(BakeStats))
         self.check(_function("dqj_bake_get_stats")(self.handle, ctypes.byref(stats)), "bake stats")
         return stats

@@ -82,9 +82,9 @@ CACHE = os.path.join(ARGS.work, "cache")
 report("Blender %s (%s), case %s" % (bpy.app.version_string, common.blender_kind(), ARGS.case))
 dqjulia = common.install_addon(ARGS.zip, CACHE)
 MODULE = dqjulia.__name__
-animation, bakes, farm, jobs, native, osl, preview, props, slicing = (
+animation, bakes, core_state, farm, jobs, native, osl, props, slicing = (
     common.submodule(dqjulia, name)
-    for name in ("animation", "bakes", "farm", "jobs", "native", "osl", "preview", "props", "slicing")
+    for name in ("animation", "bakes", "core_state", "farm", "jobs", "native", "osl", "props", "slicing")
 )
 
 ADDON_DIR = os.path.dirname(dqjulia.__file__)
@@ -218,7 +218,7 @@ def camera_on(scene, obj):
     """An orthographic camera looking at the object's bounds from (1, -1, 0.7)."""
     from mathutils import Vector
 
-    center, radius, _clipped = preview.state_for(obj).bounds
+    center, radius, _clipped = core_state.state_for(obj).bounds
     center = obj.matrix_world @ Vector(center)
     data = bpy.data.cameras.new("test camera")
     data.type = "ORTHO"
@@ -289,7 +289,7 @@ def case_library():
     saved_expected = native.EXPECTED_VERSION
     os.environ[native.LIBRARY_ENV] = os.path.join(ARGS.work, "no-such-libdqjulia.so")
     native.reset()
-    preview.clear_cache()
+    core_state.clear_cache()
     message = native.load_error() or ""
     check("missing" in message and "reinstall" in message, "missing library: %r" % message[:120])
     result, error = common.call(bpy.ops.object.dqjulia_add)
@@ -583,7 +583,7 @@ def case_parameters():
     defaults.pop("output", None)
     mine.pop("output", None)
     check(mine == defaults, "a new object holds the core's defaults (every key of the parameter file)")
-    state = preview.state_for(obj)
+    state = core_state.state_for(obj)
     check(state.error is None and state.bounds is not None, "its parameters validate; bounds %s" % (state.bounds,))
     check(abs(obj.empty_display_size - state.bounds[1]) < 1e-5, "the empty shows the bounds' radius")
     from mathutils import Vector
@@ -595,13 +595,13 @@ def case_parameters():
         "the slice's y is Blender's Z and its z faces the front view (-Y), as `dqjulia render` shows it",
     )
     obj.dqjulia.bailout = 1.2
-    state = preview.state_for(obj)
+    state = core_state.state_for(obj)
     check(
         state.error is not None and "fractal.bailout" in state.error,
         "an invalid value is reported with the core's message: %r" % (state.error or "")[:100],
     )
     obj.dqjulia.bailout = 4.0
-    check(preview.state_for(obj).error is None, "and the valid value clears it")
+    check(core_state.state_for(obj).error is None, "and the valid value clears it")
 
 
 def case_presets():
@@ -618,7 +618,7 @@ def case_presets():
     )
     result = bpy.ops.dqjulia.load_preset(preset="paper-test2-1")
     check(result == {"FINISHED"}, "load preset paper-test2-1")
-    state = preview.state_for(obj)
+    state = core_state.state_for(obj)
     check(
         "escapes" in state.empty_reason and not state.drawable,
         "the empty slice of paper-test2-1 is explained: %r" % state.empty_reason[:90],

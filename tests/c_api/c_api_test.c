@@ -5,7 +5,7 @@
  *
  *   c_api_test [SCRATCH_DIR]   the checks
  *   c_api_test --layout        prints the size of each struct and the offset and size of each
- *                              field, for tests/native_abi_test.py to hold the ctypes bindings to */
+ *                              field, for tests/python/native_abi_test.py to hold the ctypes bindings to */
 #include <errno.h>
 #include <math.h>
 #include <stddef.h>

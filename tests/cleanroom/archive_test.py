@@ -24,8 +24,8 @@ import subprocess
 import sys
 import tarfile
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from check_report import report  # noqa: E402 (tests/check_report.py)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "common"))
+from check_report import report  # noqa: E402 (tests/common/check_report.py)
 from debian_roots import VERSIONS, debian_root, require_root_tools, run_in, scratch  # noqa: E402
 
 # (file, the command's arguments, compare_outputs kind): as tests/windows/cli_test.py makes them.

@@ -26,8 +26,8 @@ import subprocess
 import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from check_report import skip_or_fail  # noqa: E402 (tests/check_report.py)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "common"))
+from check_report import skip_or_fail  # noqa: E402 (tests/common/check_report.py)
 
 ANIMATION = {
     "slice": {"rotations": [{"plane": "a.j,b.s", "degrees": 0}]},

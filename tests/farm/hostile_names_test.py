@@ -41,8 +41,8 @@ import subprocess
 import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from check_report import skip_or_fail  # noqa: E402 (tests/check_report.py)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "common"))
+from check_report import skip_or_fail  # noqa: E402 (tests/common/check_report.py)
 from farm_test import engine_arguments  # noqa: E402 (beside this file)
 
 FRAGMENTS = [

@@ -11,8 +11,8 @@ import re
 import sys
 import zipfile
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from check_report import report  # noqa: E402 (tests/check_report.py)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "common"))
+from check_report import report  # noqa: E402 (tests/common/check_report.py)
 
 
 def main():

@@ -13,8 +13,8 @@ import subprocess
 import sys
 import tarfile
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from check_report import report  # noqa: E402 (tests/check_report.py)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "common"))
+from check_report import report  # noqa: E402 (tests/common/check_report.py)
 from wheel_support import check_wheel  # noqa: E402
 
 PLATFORM = "manylinux_2_34_x86_64"

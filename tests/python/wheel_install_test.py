@@ -25,8 +25,8 @@ import subprocess
 import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from check_report import report  # noqa: E402 (tests/check_report.py)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "common"))
+from check_report import report  # noqa: E402 (tests/common/check_report.py)
 from wheel_support import find_python, read_ply, read_png  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))

@@ -18,10 +18,10 @@ import types
 import zipfile
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-sys.path.insert(0, os.path.dirname(HERE))
+sys.path.insert(0, os.path.join(os.path.dirname(HERE), "common"))
 sys.path.insert(0, os.path.join(os.path.dirname(HERE), "windows"))
 from addon_zip_test import load_on_windows  # noqa: E402 (tests/windows: native.py's loading as on Windows)
-from check_report import report, skip_or_fail  # noqa: E402 (tests/check_report.py)
+from check_report import report, skip_or_fail  # noqa: E402 (tests/common/check_report.py)
 from wheel_support import check_wheel  # noqa: E402
 
 PLATFORM = "win_amd64"

@@ -39,8 +39,8 @@ import tarfile
 import zipfile
 from pathlib import Path
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from check_report import report, skip_or_fail  # noqa: E402 (tests/check_report.py)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "common"))
+from check_report import report, skip_or_fail  # noqa: E402 (tests/common/check_report.py)
 
 TARGETS = ("linux-x64", "windows-x64")
 ARTIFACT_MAPS = {"library": "dqjulia.map", "command": "dqjulia_cli.map"}

@@ -20,8 +20,8 @@ import sys
 import types
 import zipfile
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from check_report import report, skip_or_fail  # noqa: E402 (tests/check_report.py)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "common"))
+from check_report import report, skip_or_fail  # noqa: E402 (tests/common/check_report.py)
 
 
 def platforms(archive):

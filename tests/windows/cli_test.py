@@ -14,8 +14,8 @@ import shutil
 import subprocess
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from check_report import report, skip_or_fail  # noqa: E402 (tests/check_report.py)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "common"))
+from check_report import report, skip_or_fail  # noqa: E402 (tests/common/check_report.py)
 
 FOLDER = "cli \u00e9t\u00e9 \u65e5\u672c"  # "cli été 日本"
 

@@ -1,6 +1,6 @@
 """One version: the project's VERSION file, and every place that carries it.
 
-Usage: python3 version_test.py SOURCE_DIR ZIP CLI LIBRARY
+Usage: python3 tests/version/version_test.py SOURCE_DIR ZIP CLI LIBRARY
 Checks the zip's manifest, bl_info and build info, the POV-Ray include, the add-on's source
 literals (scripts/set-version.sh keeps them), `dqjulia --version`, the library's
 dqj_version_string()/dqj_version_number(), and that CHANGELOG.md has a section for it.
@@ -17,7 +17,8 @@ import tempfile
 import tomllib
 import zipfile
 
-from check_report import report
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "common"))
+from check_report import report  # noqa: E402 (tests/common/check_report.py)
 
 
 def main():

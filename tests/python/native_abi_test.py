@@ -6,17 +6,19 @@ bindings can never drift from the ABI they describe. Given the C test program, a
 struct's size and each field's offset and size as the C compiler lays them out
 (`c_api_test --layout`) against ctypes'.
 
-Usage: python3 native_abi_test.py SOURCE_DIR [C_API_TEST]
-       python3 native_abi_test.py SOURCE_DIR EMULATOR... C_API_TEST   (a Windows build's, under Wine)
+Usage: python3 tests/python/native_abi_test.py SOURCE_DIR [C_API_TEST]
+       python3 tests/python/native_abi_test.py SOURCE_DIR EMULATOR... C_API_TEST   (a Windows build's, under Wine)
 """
 
 import ctypes
 import importlib.util
+import os
 import re
 import subprocess
 import sys
 
-from check_report import report
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "common"))
+from check_report import report  # noqa: E402 (tests/common/check_report.py)
 
 CTYPES = {
     "int32_t": ctypes.c_int32,
