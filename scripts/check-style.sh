@@ -225,7 +225,7 @@ if [ ${#cxx[@]} -gt 0 ] && [ "$mode" != fix ]; then
 fi
 
 if [ "$failed" -ne 0 ]; then
-  echo "check-style: FAILED (scripts/check-style.sh --fix reformats the changed lines; README, Style)" >&2
+  echo "check-style: FAILED (scripts/check-style.sh --fix reformats the changed lines; CONTRIBUTING.md, Style)" >&2
   exit 1
 fi
 echo "check-style: clean$skipped"
