@@ -59,6 +59,16 @@ git -C "$root/root/dqjulia" checkout -q -B main "$commit"
 chmod 0700 "$root/root"
 echo "check-clean-machine.sh: a fresh Debian 12 minbase root in $root ($(cut -d= -f2 <<<"$(grep ^mirror= "$root/etc/dqjulia-root")"))," \
      "this checkout's $(git rev-parse --short HEAD) in its /root/dqjulia (/root mode $(stat -c %a "$root/root")), in $((SECONDS - started)) s"
+# The network, not the machine: where this machine reaches PyPI through a proxy that signs TLS
+# with its own authority (pip told so by PIP_CERT or SSL_CERT_FILE), the root is on the same
+# network and is told the same, in Debian's site-wide /etc/pip.conf. On an open network nothing
+# is added.
+network_ca=${PIP_CERT:-${SSL_CERT_FILE:-}}
+if [ -n "$network_ca" ] && [ -f "$network_ca" ]; then
+  cp "$network_ca" "$root/etc/dqjulia-network-ca.crt"
+  printf '[global]\ncert = /etc/dqjulia-network-ca.crt\n' > "$root/etc/pip.conf"
+  echo "check-clean-machine.sh: this network's certificate authorities ($network_ca) given to pip in the root (/etc/pip.conf)"
+fi
 python=$(chroot "$root" /bin/sh -c 'command -v python3 pyenv || true')
 echo "check-clean-machine.sh: python3 or pyenv before the quickstart: ${python:-none}"
 
