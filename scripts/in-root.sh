@@ -44,6 +44,9 @@ exec unshare --mount --pid --fork --kill-child --propagation private -- /bin/bas
   set -e
   root=$1
   shift
+  # The root a mount point of its own, as / is on a machine: a command inside that makes its own
+  # namespaces (unshare --propagation, as this script does in a root made inside) needs one.
+  mount --bind "$root" "$root"
   mount -t proc proc "$root/proc"
   mount --rbind /sys "$root/sys"
   mount --rbind /dev "$root/dev"
