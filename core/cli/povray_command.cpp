@@ -6,6 +6,7 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "dqjulia/empty_result.hpp"
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/povray.hpp"
 #include "file_names.hpp"
@@ -44,7 +45,8 @@ int runPovray(const PovrayOptions& options) {
     validate(params);
     // An empty picture needs a reason, in POV-Ray as in `dqjulia render`.
     const std::string provenEmpty = provenEmptyReason(params);
-    if (!provenEmpty.empty()) std::cerr << "dqjulia povray: warning: the scene has no fractal: " << provenEmpty << "\n";
+    if (!provenEmpty.empty())
+        std::cerr << "dqjulia povray: warning: " << emptyResultMessage(EmptyResult::Povray, provenEmpty) << "\n";
 
     PovrayWriteOptions write;
     write.copyInclude = !options.noInclude;

@@ -6,7 +6,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "dqjulia/image.hpp"
-#include "dqjulia/inspect.hpp"
+#include "dqjulia/empty_result.hpp"
 #include "dqjulia/render.hpp"
 #include "image_writer.hpp"
 #include "schema_options.hpp"
@@ -71,10 +71,6 @@ int runRender(const RenderOptions& options) {
     // The image and the parameter file are published together, once the image is done: both or neither.
     AtomicFileSet files(existingPolicy(options.force));
     if (options.saveParamsGiven) files.add(options.saveParams).stream() << toJson(params);
-    // Say up front when the slice is provably empty: an empty picture needs a reason.
-    const std::string provenEmpty = provenEmptyReason(params);
-    if (!provenEmpty.empty()) std::cerr << "dqjulia render: warning: " << provenEmpty << "\n";
-
     ProgressBar progress("rendering", options.quiet);
     const RenderResult result = options.voxels.empty() ? render(params, progress.callback())
                                                        : renderVoxels(params, options.voxels, progress.callback());
@@ -84,15 +80,9 @@ int runRender(const RenderOptions& options) {
     files.commit();
 
     const RenderStats& stats = result.stats;
-    if (stats.hitPixels == 0) {
-        const std::string reason = provenEmpty.empty() ? inspect(params).emptyReason : provenEmpty;
-        std::cerr
-            << "dqjulia render: warning: the image shows no surface: "
-            << (reason.empty()
-                    ? "no ray came within the hit threshold; try more iterations, a larger --detail or another camera"
-                    : reason)
-            << "\n";
-    }
+    // An empty picture needs a reason: the render's own (render.hpp).
+    if (stats.hitPixels == 0)
+        std::cerr << "dqjulia render: warning: " << emptyResultMessage(EmptyResult::Render, result.emptyReason) << "\n";
     if (!options.quiet)
         std::cerr << "wrote " << params.output.path << " (" << params.render.width << "x" << params.render.height
                   << ", " << stats.hitPixels << " pixels on the surface, " << std::fixed << std::setprecision(2)
