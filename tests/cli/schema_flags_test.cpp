@@ -54,27 +54,12 @@ protected:
     /// Every command ("render", "farm slurm", ...), from the help.
     std::vector<std::string> commands() {
         std::vector<std::string> result;
-        for (const std::string& command : section(run("--help").out, "Subcommands:")) {
-            const std::vector<std::string> sub = section(run(command + " --help").out, "Subcommands:");
+        for (const std::string& command : dqj::test::helpSection(run("--help").out, "Subcommands:")) {
+            const std::vector<std::string> sub = dqj::test::helpSection(run(command + " --help").out, "Subcommands:");
             if (sub.empty()) result.push_back(command);
             for (const std::string& name : sub) result.push_back(command + " " + name);
         }
         return result;
-    }
-
-    static std::vector<std::string> section(const std::string& help, const std::string& title) {
-        std::vector<std::string> names;
-        std::istringstream lines(help);
-        bool inside = false;
-        for (std::string line; std::getline(lines, line);) {
-            if (line.rfind(title, 0) == 0) {
-                inside = true;
-                continue;
-            }
-            if (inside && (line.empty() || line[0] != ' ')) inside = false;
-            if (inside && line.size() > 2 && line[2] != ' ') names.push_back(line.substr(2, line.find(' ', 2) - 2));
-        }
-        return names;
     }
 
     /// The options of a help text. A description starts in CLI11's column, or on the next line
