@@ -8,6 +8,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "dqjulia/bake.hpp"
+#include "dqjulia/empty_result.hpp"
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/threads.hpp"
 #include "dqjulia/tiles.hpp"
@@ -94,15 +95,9 @@ int runBake(const BakeFlags& flags) {
             }
             bar.finish();
         }
-        if (stats.activeVoxels == 0 && !job.tile) {  // a tile may lie where the surface is not
-            const std::string reason = inspect(job.params).emptyReason;
-            std::cerr << "dqjulia bake: warning: " << job.path << " holds no surface: "
-                      << (reason.empty()
-                              ? "nothing within the bounds is in the set at this resolution; try more iterations or a "
-                                "higher resolution"
-                              : reason)
-                      << "\n";
-        }
+        if (stats.activeVoxels == 0 && !job.tile)  // a tile may lie where the surface is not
+            std::cerr << "dqjulia bake: warning: "
+                      << emptyResultMessage(EmptyResult::Bake, inspect(job.params).emptyReason, job.path) << "\n";
         if (!flags.quiet)
             std::cerr << "wrote " << job.path << " (" << job.params.bake.resolution << " voxels across, voxel size "
                       << std::setprecision(4) << stats.voxelSize << "; " << evaluatedSummary(stats) << "; "

@@ -11,6 +11,7 @@
 #include "dqjulia/threads.hpp"
 #include "file_names.hpp"
 #include "message_text.hpp"
+#include "schema_options.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -71,28 +72,15 @@ void BakeFlags::addTo(CLI::App& command, BakeCommand kind) {
                     : kind == BakeCommand::Farm ? "The bake's output file (.vdb), on storage every machine shares"
                                                 : "Output OpenVDB file (.vdb)")
         ->required();
-    command
-        .add_option("-r,--resolution", resolution,
-                    "Voxels across the largest side of the bounds (8..16384; default 256)")
-        ->check(CLI::Range(8, 16384));
-    command.add_option("--bounds-min", boundsMin, "Bake only this box: its lowest corner x y z (with --bounds-max)")
-        ->expected(3);
-    command.add_option("--bounds-max", boundsMax, "Bake only this box: its highest corner x y z (with --bounds-min)")
-        ->expected(3);
+    schemaOption(command, "-r,--resolution", "bake.resolution", resolution);
+    schemaOption(command, "--bounds-min", "bake.bounds.min", boundsMin, "Bakes only this box (with --bounds-max)");
+    schemaOption(command, "--bounds-max", "bake.bounds.max", boundsMax, "Bakes only this box (with --bounds-min)");
     if (mesh) {
-        command
-            .add_option("--adaptivity", adaptivity,
-                        "0 = uniform quads; up to 1 merges flat regions into fewer polygons")
-            ->check(CLI::Range(0.0, 1.0));
-        command.add_flag("--no-colors", noColors, "No vertex colours");
+        schemaOption(command, "--adaptivity", "bake.adaptivity", adaptivity);
+        schemaOffFlag(command, "--no-colors", "bake.mesh_colors", noColors);
     } else {
-        command.add_option("--grids", grids,
-                           "Grids to write, comma-separated: surface, density, color, trap, iterations "
-                           "(default surface,density)");
-        command
-            .add_option("--band-width", bandWidth,
-                        "Half width of the level set's narrow band in voxels (1..32; default 3)")
-            ->check(CLI::Range(1.0, 32.0));
+        schemaOption(command, "--grids", "bake.grids", grids);
+        schemaOption(command, "--band-width", "bake.band_width", bandWidth);
     }
     command.add_option(
         "--frames", frames,
@@ -114,7 +102,7 @@ void BakeFlags::addTo(CLI::App& command, BakeCommand kind) {
     command
         .add_option("--threads", threads,
                     "Threads to use (default: SLURM_CPUS_PER_TASK, else the CPUs this process may run on)")
-        ->check(CLI::Range(1, 4096));
+        ->check(CLI::Range(1, kMaxThreadCount));
     command.add_flag("--skip-existing", skipExisting,
                      "Skip the frames (and tiles) whose output file exists: they are complete, since files get their "
                      "name only when complete");
@@ -181,22 +169,13 @@ Params BakeFlags::load() const {
     if (bandWidth) bake.bandWidth = *bandWidth;
     if (adaptivity) bake.adaptivity = *adaptivity;
     if (noColors) bake.meshColors = false;
-    if (!grids.empty()) {
+    if (!grids.empty()) {  // names the option's check accepted; one named twice is written once
         bake.grids.clear();
         std::size_t start = 0;
         while (start <= grids.size()) {
             const std::size_t comma = std::min(grids.find(',', start), grids.size());
-            const std::string name = grids.substr(start, comma - start);
-            bool known = false;
-            for (BakeGrid grid :
-                 {BakeGrid::Surface, BakeGrid::Density, BakeGrid::Color, BakeGrid::Trap, BakeGrid::Iterations}) {
-                if (name != bakeGridName(grid)) continue;
-                known = true;
-                if (!hasGrid(bake, grid)) bake.grids.push_back(grid);
-            }
-            if (!known)
-                throw ParamError("bake.grids", "--grids: unknown grid \"" + inputExcerpt(name) +
-                                                   "\" (grids: surface, density, color, trap, iterations)");
+            const auto grid = schemaChoice<BakeGrid>("bake.grids", grids.substr(start, comma - start));
+            if (!hasGrid(bake, grid)) bake.grids.push_back(grid);
             start = comma + 1;
         }
     }

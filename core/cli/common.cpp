@@ -19,6 +19,7 @@
 #include "dqjulia/estimate.hpp"
 #include "file_names.hpp"
 #include "message_text.hpp"
+#include "schema_options.hpp"
 
 namespace dqj::cli {
 namespace {
@@ -137,14 +138,14 @@ CLI::Validator existingFile() {
 void FractalOptions::addTo(CLI::App& command) {
     command.add_option("-p,--params", paramsFile, "Parameter file (JSON, see README); flags override its values")
         ->check(existingFile());
-    command.add_option("--c", constant, "Constant: 8 numbers, a's s i j k then b's s i j k")->expected(8);
-    command.add_option("--variant", variant, "Algebra: paper, paper-coupled or dual")
-        ->check(CLI::IsMember({"paper", "paper-coupled", "dual"}));
-    command.add_option("-n,--iterations", iterations, "Iterations N (1..100000)");
-    command.add_option("--bailout", bailout, "Bailout radius R (at least the containment radius r_K)");
-    command.add_option("--slice", sliceAxes, "Slice axes by name, e.g. a.s,a.i,a.j or a.i,a.j,b.s");
-    command.add_option("--slice-origin", sliceOrigin, "Slice origin: 8 numbers")->expected(8);
-    command.add_option("--rotate", rotations, "Turn the slice: PLANE:DEGREES, e.g. a.j,b.s:30 (repeatable)");
+    schemaOption(command, "--c", "fractal.c", constant);
+    schemaOption(command, "--variant", "fractal.variant", variant);
+    schemaOption(command, "-n,--iterations", "fractal.iterations", iterations);
+    schemaOption(command, "--bailout", "fractal.bailout", bailout);
+    schemaOption(command, "--slice", "slice.axes", sliceAxes, "Here by name only, e.g. a.s,a.i,a.j or a.i,a.j,b.s");
+    schemaOption(command, "--slice-origin", "slice.origin", sliceOrigin);
+    schemaOption(command, "--rotate", "slice.rotations", rotations,
+                 "Here one rotation as PLANE:DEGREES, e.g. a.j,b.s:30 (repeatable)");
 }
 
 void FractalOptions::applyTo(Params& params) const {
@@ -153,7 +154,7 @@ void FractalOptions::applyTo(Params& params) const {
         std::copy(constant.begin(), constant.end(), values.begin());
         params.fractal.c = toDualQuat(values);
     }
-    if (!variant.empty()) params.fractal.variant = *parseVariant(variant);
+    if (!variant.empty()) params.fractal.variant = schemaChoice<Variant>("fractal.variant", variant);
     if (iterations) params.fractal.iterations = *iterations;
     if (bailout) params.fractal.bailout = *bailout;
     if (!sliceAxes.empty()) {

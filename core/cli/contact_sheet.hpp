@@ -21,6 +21,10 @@ struct SheetTile {
     std::string label;  ///< "\n" separates lines; long lines wrap
 };
 
+/// The most columns and label lines a sheet takes (dqjulia sheet and explore check them).
+inline constexpr int kMaxSheetColumns = 20;
+inline constexpr int kMaxLabelLines = 20;
+
 struct SheetLayout {
     int columns = 3;
     int padding = 8;                           ///< pixels around and between cells

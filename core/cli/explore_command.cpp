@@ -131,7 +131,7 @@ Runner addExploreCommand(CLI::App& app) {
     options->fractal.addTo(*command);
     command->add_option("--seed", options->seed, "Random seed (the same seed gives the same constants)");
     command->add_option("--count", options->count, "Number of tiles")->check(CLI::Range(1, 100));
-    command->add_option("--columns", options->columns, "Tiles per row")->check(CLI::Range(1, 20));
+    command->add_option("--columns", options->columns, "Tiles per row")->check(CLI::Range(1, kMaxSheetColumns));
     command->add_option("--tile-width", options->width, "Tile width in pixels")->check(CLI::Range(16, 4096));
     command->add_option("--tile-height", options->height, "Tile height in pixels")->check(CLI::Range(16, 4096));
     command->add_option("-s,--samples", options->samples, "Anti-aliasing per tile: S x S rays a pixel")

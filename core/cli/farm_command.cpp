@@ -33,6 +33,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "dqjulia/dqjulia.h"
+#include "dqjulia/threads.hpp"
 #include "dqjulia/tiles.hpp"
 #include "file_names.hpp"
 #include "job_files.hpp"
@@ -373,7 +374,7 @@ Runner addFarmCommand(CLI::App& app) {
     slurmCommand->add_option("--script", slurm->file,
                              "The array script to write (default: NAME.slurm beside --output)");
     slurmCommand->add_option("--cpus-per-task", slurm->cpus, "CPUs a task gets, and the threads it uses (default 1)")
-        ->check(CLI::Range(1, 4096));
+        ->check(CLI::Range(1, kMaxThreadCount));
     slurmCommand->add_option("--partition", slurm->partition, "sbatch --partition");
     slurmCommand->add_option("--time", slurm->time, "sbatch --time, a task's time limit");
     slurmCommand->add_option("--mem", slurm->memory, "sbatch --mem, a task's memory");

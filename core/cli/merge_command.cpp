@@ -87,7 +87,7 @@ Runner addMergeCommand(CLI::App& app) {
     command
         ->add_option("--threads", flags->bake.threads,
                      "Threads to use (default: SLURM_CPUS_PER_TASK, else the CPUs this process may run on)")
-        ->check(CLI::Range(1, 4096));
+        ->check(CLI::Range(1, kMaxThreadCount));
     command->add_option("--max-memory", flags->bake.maxMemory,
                         "Refuse when the estimate exceeds this, e.g. 4G or 512M (default: half the available memory)");
     command->add_flag("--skip-existing", flags->bake.skipExisting, "Skip the outputs that exist: they are complete");

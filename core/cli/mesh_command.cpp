@@ -6,6 +6,7 @@
 #include "bake_options.hpp"
 #include "commands.hpp"
 #include "common.hpp"
+#include "dqjulia/empty_result.hpp"
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/mesh.hpp"
 #include "dqjulia/threads.hpp"
@@ -67,12 +68,10 @@ int runMesh(const BakeFlags& flags) {
             return kInterrupted;
         }
         writeMesh(mesh, paths[index], existingPolicy(flags.force));
-        if (mesh.positions.empty()) {
-            const std::string reason = inspect(perFrame[index]).emptyReason;
-            std::cerr << "dqjulia mesh: warning: " << paths[index] << " is empty: "
-                      << (reason.empty() ? "nothing within the bounds is in the set at this resolution" : reason)
+        if (mesh.positions.empty())
+            std::cerr << "dqjulia mesh: warning: "
+                      << emptyResultMessage(EmptyResult::Mesh, inspect(perFrame[index]).emptyReason, paths[index])
                       << "\n";
-        }
         if (!flags.quiet)
             std::cerr << "wrote " << paths[index] << " (" << mesh.positions.size() << " vertices, "
                       << mesh.quads.size() + mesh.triangles.size() << " faces; " << evaluatedSummary(stats) << "; "

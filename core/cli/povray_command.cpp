@@ -6,10 +6,12 @@
 
 #include "commands.hpp"
 #include "common.hpp"
+#include "dqjulia/empty_result.hpp"
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/povray.hpp"
 #include "file_names.hpp"
 #include "message_text.hpp"
+#include "schema_options.hpp"
 #include "text_input.hpp"
 
 namespace dqj::cli {
@@ -39,13 +41,12 @@ int runPovray(const PovrayOptions& options) {
     if (options.detail) params.render.detail = *options.detail;
     if (options.fov) params.camera.fovDegrees = *options.fov;
     if (!options.coloring.empty())
-        params.material.coloring = options.coloring == "solid"        ? Coloring::Solid
-                                   : options.coloring == "iterations" ? Coloring::Iterations
-                                                                      : Coloring::Trap;
+        params.material.coloring = schemaChoice<Coloring>("material.coloring", options.coloring);
     validate(params);
     // An empty picture needs a reason, in POV-Ray as in `dqjulia render`.
     const std::string provenEmpty = provenEmptyReason(params);
-    if (!provenEmpty.empty()) std::cerr << "dqjulia povray: warning: the scene has no fractal: " << provenEmpty << "\n";
+    if (!provenEmpty.empty())
+        std::cerr << "dqjulia povray: warning: " << emptyResultMessage(EmptyResult::Povray, provenEmpty) << "\n";
 
     PovrayWriteOptions write;
     write.copyInclude = !options.noInclude;
@@ -106,21 +107,19 @@ Runner addPovrayCommand(CLI::App& app) {
         "the fractal as an isosurface of the same distance estimate (dqjulia.inc, written beside it)");
     options->fractal.addTo(*command);
     command->add_option("-o,--output", options->output, "Scene file to write, e.g. scene.pov")->required();
-    command->add_option("-W,--width", options->width, "Image width the view is framed for");
-    command->add_option("-H,--height", options->height, "Image height the view is framed for");
-    command->add_option("-s,--samples", options->samples,
-                        "Anti-aliasing: S x S rays per pixel (in the render command)");
-    command->add_option("--detail", options->detail, "Hit threshold in pixel footprints (smaller = finer)");
-    command->add_option("--fov", options->fov, "Vertical field of view in degrees");
-    command->add_option("--coloring", options->coloring, "solid, iterations or trap")
-        ->check(CLI::IsMember({"solid", "iterations", "trap"}));
+    schemaOption(*command, "-W,--width", "render.width", options->width, "The image width the view is framed for");
+    schemaOption(*command, "-H,--height", "render.height", options->height, "The image height the view is framed for");
+    schemaOption(*command, "-s,--samples", "render.samples", options->samples, "In the scene's render command");
+    schemaOption(*command, "--detail", "render.detail", options->detail);
+    schemaOption(*command, "--fov", "camera.fov", options->fov);
+    schemaOption(*command, "--coloring", "material.coloring", options->coloring);
     command->add_flag("--df3", options->df3,
                       "Also bake <scene>.df3 (the distance estimate on a grid) and <scene>_df3.pov drawing it: fast\n"
                       "renders of heavy settings, at the grid's resolution");
     command->add_option("--df3-resolution", options->df3Resolution, "Samples per axis of the DF3 grid")
-        ->check(CLI::Range(2, 512));
+        ->check(CLI::Range(kMinDf3Resolution, kMaxDf3Resolution));
     command->add_option("--df3-bits", options->df3Bits, "Bits per DF3 sample: 8, 16 or 32")
-        ->check(CLI::IsMember({8, 16, 32}));
+        ->check(CLI::IsMember(std::vector<int>(kDf3Bits.begin(), kDf3Bits.end())));
     command->add_flag("--no-include", options->noInclude,
                       "Do not write dqjulia.inc beside the scene (render with +L<dqjulia>/povray)");
     command->add_flag("-f,--force", options->force, "Overwrite existing output files");

@@ -6,9 +6,10 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "dqjulia/image.hpp"
-#include "dqjulia/inspect.hpp"
+#include "dqjulia/empty_result.hpp"
 #include "dqjulia/render.hpp"
 #include "image_writer.hpp"
+#include "schema_options.hpp"
 #include "voxel_render.hpp"
 
 namespace dqj::cli {
@@ -38,11 +39,7 @@ Params loadRenderParams(const RenderOptions& options) {
         if (options.output->empty()) throw ParamError("output.path", "--output is empty; give a file name");
         params.output.path = *options.output;
     }
-    if (!options.format.empty()) {
-        params.output.format = options.format == "png16" ? ImageFormat::Png16
-                               : options.format == "exr" ? ImageFormat::Exr
-                                                         : ImageFormat::Png8;
-    }
+    if (!options.format.empty()) params.output.format = schemaChoice<ImageFormat>("output.format", options.format);
     RenderSettings& render = params.render;
     if (options.width) render.width = *options.width;
     if (options.height) render.height = *options.height;
@@ -52,14 +49,9 @@ Params loadRenderParams(const RenderOptions& options) {
     if (options.maxStep) render.maxStep = *options.maxStep;
     if (options.detail) render.detail = *options.detail;
     if (options.fov) params.camera.fovDegrees = *options.fov;
-    if (!options.normals.empty())
-        render.normals = options.normals == "central"    ? NormalMethod::CentralDifferences
-                         : options.normals == "analytic" ? NormalMethod::Analytic
-                                                         : NormalMethod::Auto;
+    if (!options.normals.empty()) render.normals = schemaChoice<NormalMethod>("render.normals", options.normals);
     if (!options.coloring.empty())
-        params.material.coloring = options.coloring == "solid"        ? Coloring::Solid
-                                   : options.coloring == "iterations" ? Coloring::Iterations
-                                                                      : Coloring::Trap;
+        params.material.coloring = schemaChoice<Coloring>("material.coloring", options.coloring);
     if (!options.cameraPosition.empty())
         params.camera.position =
             glm::dvec3(options.cameraPosition[0], options.cameraPosition[1], options.cameraPosition[2]);
@@ -79,10 +71,6 @@ int runRender(const RenderOptions& options) {
     // The image and the parameter file are published together, once the image is done: both or neither.
     AtomicFileSet files(existingPolicy(options.force));
     if (options.saveParamsGiven) files.add(options.saveParams).stream() << toJson(params);
-    // Say up front when the slice is provably empty: an empty picture needs a reason.
-    const std::string provenEmpty = provenEmptyReason(params);
-    if (!provenEmpty.empty()) std::cerr << "dqjulia render: warning: " << provenEmpty << "\n";
-
     ProgressBar progress("rendering", options.quiet);
     const RenderResult result = options.voxels.empty() ? render(params, progress.callback())
                                                        : renderVoxels(params, options.voxels, progress.callback());
@@ -92,15 +80,9 @@ int runRender(const RenderOptions& options) {
     files.commit();
 
     const RenderStats& stats = result.stats;
-    if (stats.hitPixels == 0) {
-        const std::string reason = provenEmpty.empty() ? inspect(params).emptyReason : provenEmpty;
-        std::cerr
-            << "dqjulia render: warning: the image shows no surface: "
-            << (reason.empty()
-                    ? "no ray came within the hit threshold; try more iterations, a larger --detail or another camera"
-                    : reason)
-            << "\n";
-    }
+    // An empty picture needs a reason: the render's own (render.hpp).
+    if (stats.hitPixels == 0)
+        std::cerr << "dqjulia render: warning: " << emptyResultMessage(EmptyResult::Render, result.emptyReason) << "\n";
     if (!options.quiet)
         std::cerr << "wrote " << params.output.path << " (" << params.render.width << "x" << params.render.height
                   << ", " << stats.hitPixels << " pixels on the surface, " << std::fixed << std::setprecision(2)
@@ -120,24 +102,21 @@ Runner addRenderCommand(CLI::App& app) {
     auto options = std::make_shared<RenderOptions>();
     CLI::App* command = app.add_subcommand("render", "Render an image by sphere tracing the distance estimate");
     options->fractal.addTo(*command);
-    command->add_option("-o,--output", options->output,
-                        "Output image: .png (8-bit sRGB) or .exr (linear, depth, normals)");
-    command->add_option("--format", options->format, "png8, png16 or exr (default: from the file name)")
-        ->check(CLI::IsMember({"png8", "png16", "exr"}));
-    command->add_option("-W,--width", options->width, "Image width in pixels");
-    command->add_option("-H,--height", options->height, "Image height in pixels");
-    command->add_option("-s,--samples", options->samples, "Anti-aliasing: S x S rays per pixel");
-    command->add_option("--step-factor", options->stepFactor, "Fraction of the distance estimate per step (0..1]");
-    command->add_option("--max-step", options->maxStep, "Largest step in slice units");
-    command->add_option("--max-steps", options->maxSteps, "Most steps per ray");
-    command->add_option("--detail", options->detail, "Hit threshold in pixel footprints (smaller = finer)");
-    command->add_option("--fov", options->fov, "Vertical field of view in degrees");
-    command->add_option("--normals", options->normals, "auto, central or analytic (dual variant)")
-        ->check(CLI::IsMember({"auto", "central", "analytic"}));
-    command->add_option("--coloring", options->coloring, "solid, iterations or trap")
-        ->check(CLI::IsMember({"solid", "iterations", "trap"}));
-    command->add_option("--camera-position", options->cameraPosition, "Camera position x y z")->expected(3);
-    command->add_option("--camera-target", options->cameraTarget, "Camera target x y z")->expected(3);
+    schemaOption(*command, "-o,--output", "output.path", options->output,
+                 "PNG: 8-bit sRGB (16-bit with --format png16); EXR: linear, with depth and normals");
+    schemaOption(*command, "--format", "output.format", options->format);
+    schemaOption(*command, "-W,--width", "render.width", options->width);
+    schemaOption(*command, "-H,--height", "render.height", options->height);
+    schemaOption(*command, "-s,--samples", "render.samples", options->samples);
+    schemaOption(*command, "--step-factor", "render.step_factor", options->stepFactor);
+    schemaOption(*command, "--max-step", "render.max_step", options->maxStep);
+    schemaOption(*command, "--max-steps", "render.max_steps", options->maxSteps);
+    schemaOption(*command, "--detail", "render.detail", options->detail);
+    schemaOption(*command, "--fov", "camera.fov", options->fov);
+    schemaOption(*command, "--normals", "render.normals", options->normals);
+    schemaOption(*command, "--coloring", "material.coloring", options->coloring);
+    schemaOption(*command, "--camera-position", "camera.position", options->cameraPosition);
+    schemaOption(*command, "--camera-target", "camera.target", options->cameraTarget);
     command->add_option("--save-params", options->saveParams, "Also write the complete parameter file used");
     command
         ->add_option("--voxels", options->voxels,

@@ -45,9 +45,9 @@ Runner addSheetCommand(CLI::App& app) {
         ->check(existingFile());
     command->add_option("-l,--label", options->labels, "Its label (repeat, one per --tile; \\n breaks lines)");
     command->add_option("-o,--output", options->output, "The sheet (.png)")->required();
-    command->add_option("--columns", options->columns, "Tiles per row")->check(CLI::Range(1, 20));
+    command->add_option("--columns", options->columns, "Tiles per row")->check(CLI::Range(1, kMaxSheetColumns));
     command->add_option("--label-lines", options->labelLines, "Text lines reserved under each tile")
-        ->check(CLI::Range(0, 20));
+        ->check(CLI::Range(0, kMaxLabelLines));
     command->add_flag("-f,--force", options->force, "Overwrite an existing sheet");
     return [options] { return reportErrors("sheet", [&] { return runSheet(*options); }); };
 }

@@ -18,6 +18,7 @@
 
 #include "dqjulia/bake.hpp"
 #include "dqjulia/image.hpp"
+#include "dqjulia/empty_result.hpp"
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/mesh.hpp"
 #include "dqjulia/params.hpp"
@@ -200,25 +201,14 @@ dqj_status withFileErrors(dqj_context_t& context, Work&& work) {
 }
 
 /// After a bake or mesh: if there is no surface, say why (like noteEmptyRender).
-void noteEmptyBake(dqj_context_t& context, const dqj::Params& params, bool empty) {
-    if (!empty) return;
-    const dqj::InspectReport report = dqj::inspect(params);
-    context.warning =
-        "the bake found no surface: " +
-        (report.emptyReason.empty() ? std::string("nothing within the bounds is in the set at this resolution; "
-                                                  "try more iterations or a higher resolution")
-                                    : report.emptyReason);
+void noteEmptyBake(dqj_context_t& context, const dqj::Params& params, dqj::EmptyResult kind, bool empty) {
+    if (empty) context.warning = dqj::emptyResultMessage(kind, dqj::inspect(params).emptyReason);
 }
 
 /// After a render: if nothing was hit, say why on the context (a silent empty picture is a bug).
 void noteEmptyRender(dqj_context_t& context, const dqj::RenderResult& result) {
-    if (result.stats.hitPixels != 0) return;
-    const dqj::InspectReport report = dqj::inspect(context.params);
-    context.warning =
-        "the render found no surface: " +
-        (report.emptyReason.empty() ? std::string("no ray came within the hit threshold; try more iterations, "
-                                                  "a larger render.detail or another camera")
-                                    : report.emptyReason);
+    if (result.stats.hitPixels == 0)
+        context.warning = dqj::emptyResultMessage(dqj::EmptyResult::Render, result.emptyReason);
 }
 
 }  // namespace
@@ -490,7 +480,7 @@ dqj_status dqj_bake_vdb(dqj_context context, const char* path, dqj_progress_fn p
         });
         if (status != DQJ_OK) return status;
         self.bakeStats = stats;
-        noteEmptyBake(self, params, stats.activeVoxels == 0);
+        noteEmptyBake(self, params, dqj::EmptyResult::Bake, stats.activeVoxels == 0);
         return DQJ_OK;
     });
 }
@@ -505,7 +495,7 @@ dqj_status dqj_mesh_compute(dqj_context context, dqj_progress_fn progress, void*
         if (mesh.positions.size() > UINT32_MAX) return invalidArgument(self, "the mesh has more than 2^32 vertices");
         self.mesh = std::move(mesh);
         self.bakeStats = stats;
-        noteEmptyBake(self, params, self.mesh.positions.empty());
+        noteEmptyBake(self, params, dqj::EmptyResult::Mesh, self.mesh.positions.empty());
         return DQJ_OK;
     });
 }

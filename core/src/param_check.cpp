@@ -21,6 +21,8 @@ using schema::Type;
     throw ParamError(key, prefix + (key.empty() ? "" : key + ": ") + message);
 }
 
+}  // namespace
+
 void checkNumber(const Field& field, const Json& value, const std::string& key, const std::string& prefix) {
     if (value.is_null()) fail(key, prefix, "must be a finite number");
     if (!value.is_number()) fail(key, prefix, "must be a number, got " + describe(value));
@@ -41,6 +43,8 @@ void checkNumber(const Field& field, const Json& value, const std::string& key, 
                  (field.maxExclusive ? " and less than " : " and at most ") + formatNumber(field.max) + ", got " +
                  formatNumber(x));
 }
+
+namespace {
 
 std::string choiceList(const Field& field) {
     std::string allowed;

@@ -20,6 +20,11 @@ namespace dqj::detail {
 /// key + ": " + what is wrong and what is allowed).
 void checkValue(const schema::Field& field, const json::Json& value, const std::string& key, const std::string& prefix);
 
+/// Checks that `value` is a finite number within the field's range (a whole number for an
+/// Integer field); for a vector field, one of its components.
+void checkNumber(const schema::Field& field, const json::Json& value, const std::string& key,
+                 const std::string& prefix);
+
 /// Checks that `value` is an array of `size` numbers, each within the field's range.
 void checkVector(const schema::Field& field, const json::Json& value, const std::string& key, const std::string& prefix,
                  std::size_t size);

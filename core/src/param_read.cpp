@@ -84,9 +84,7 @@ public:
     Enum choice(const Json& value, const std::string& key, const std::string& fieldKey) const {
         const schema::Field& field = schema::field(fieldKey);
         detail::checkChoice(field, value, key, source_ + ": ");
-        std::size_t index = 0;
-        while (value.get<std::string>() != field.choices[index].name) ++index;  // checkChoice found it
-        return static_cast<Enum>(index);
+        return static_cast<Enum>(*schema::choiceIndex(field, value.get_ref<const std::string&>()));  // checked
     }
     template <typename Enum>
     Enum choice(const Json& value, const std::string& key) const {

@@ -374,7 +374,7 @@ std::string povrayCommand(const Params& params, const std::string& scene) {
 std::string povrayScene(const Params& params, const PovraySceneOptions& options) { return buildScene(params, options); }
 
 DensityGrid bakeDensityGrid(const Params& params, int resolution, const ProgressCallback& progress) {
-    if (resolution < 2 || resolution > 512)
+    if (resolution < kMinDf3Resolution || resolution > kMaxDf3Resolution)
         throw ParamError("df3.resolution",
                          "the density grid's resolution must be from 2 to 512 samples per axis, got " +
                              std::to_string(resolution));
@@ -476,7 +476,7 @@ PovrayFiles povrayFiles(const Params& params, const std::string& scenePath, cons
 
 std::vector<std::string> writePovray(const Params& params, const std::string& scenePath,
                                      const PovrayWriteOptions& options, const ProgressCallback& progress) {
-    if (options.df3 && options.df3Bits != 8 && options.df3Bits != 16 && options.df3Bits != 32)
+    if (options.df3 && std::find(kDf3Bits.begin(), kDf3Bits.end(), options.df3Bits) == kDf3Bits.end())
         throw ParamError("df3.bits", "DF3 samples are 8, 16 or 32 bits, got " + std::to_string(options.df3Bits));
     const PovrayFiles files = povrayFiles(params, scenePath, options);
 

@@ -1104,7 +1104,8 @@ CameraFrame frameCamera(const Params& params, const Bounds& bounds) {
 RenderResult render(const Params& params, const ProgressCallback& progress, RenderEngine engine) {
     validate(params);
     const auto start = std::chrono::steady_clock::now();
-    const Scene scene(params, !provenEmptyReason(params).empty());
+    const std::string provenEmpty = provenEmptyReason(params);
+    const Scene scene(params, !provenEmpty.empty());
 
     RenderResult result;
     Image& image = result.image;
@@ -1141,6 +1142,8 @@ RenderResult render(const Params& params, const ProgressCallback& progress, Rend
     result.stats.hitPixels = hitPixels;
     result.stats.evaluations = evaluations;
     result.stats.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (result.stats.hitPixels == 0)
+        result.emptyReason = provenEmpty.empty() ? inspect(params).emptyReason : provenEmpty;
     return result;
 }
 

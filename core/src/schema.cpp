@@ -463,6 +463,12 @@ std::string_view choiceName(std::string_view key, int index) {
     return choices.choices[std::size_t(index)].name;
 }
 
+std::optional<int> choiceIndex(const Field& field, std::string_view name) {
+    for (std::size_t index = 0; index < field.choices.size(); ++index)
+        if (field.choices[index].name == name) return int(index);
+    return std::nullopt;
+}
+
 std::string schemaJson() {
     const Json defaults = Json::parse(toJson(Params{}));
     const Json examples = Json::parse(toJson(prototype()));

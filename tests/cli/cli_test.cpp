@@ -10,7 +10,11 @@
 #include <sstream>
 #include <string>
 
+#include "dqjulia/dqjulia.h"
+#include "dqjulia/empty_result.hpp"
 #include "dqjulia/image.hpp"
+#include "dqjulia/inspect.hpp"
+#include "dqjulia/param_file.hpp"
 #include "test_support.hpp"
 
 namespace fs = std::filesystem;
@@ -129,6 +133,53 @@ TEST_F(Cli, RenderOfAnEmptySliceSaysWhy) {
     EXPECT_EQ(result.exitCode, 0) << result.err;
     EXPECT_NE(result.err.find("no surface"), std::string::npos) << result.err;
     EXPECT_NE(result.err.find("outside the Mandelbrot set"), std::string::npos) << result.err;
+}
+
+// One wording of an empty result (issue 37): the four commands and the C ABI say that their result
+// is empty and why in emptyResultMessage's sentence, each of its kind, with the one reason
+// inspect() proves for the parameters (the paper's first "test2" constant, whose slice holds the
+// escaping dual part fixed; a box of it that the bake finds empty too).
+TEST_F(Cli, EveryCommandAndTheCAbiWordAnEmptyResultAlike) {
+    const std::string file = write("empty.json", R"({
+      "fractal": {"c": [-0.10, 0.8, -0.26, 0.15, -0.23, -0.38, -0.86, 0.64], "variant": "paper", "iterations": 8},
+      "bake": {"resolution": 40, "bounds": {"min": [-1, -1, -1], "max": [0.5, 0.5, 0.5]}}})");
+    const std::string reason = dqj::provenEmptyReason(dqj::loadParams(file));
+    ASSERT_NE(reason.find("the slice is empty for N >= 6"), std::string::npos) << reason;
+    EXPECT_EQ(dqj::inspect(dqj::loadParams(file)).emptyReason, reason);
+
+    struct Case {
+        std::string command, output;
+        dqj::EmptyResult kind;
+        bool named;  // the message names the file (bakes and meshes write one a frame)
+    };
+    for (const Case& item : {Case{"render -W 32 -H 24", "empty.png", dqj::EmptyResult::Render, false},
+                             Case{"bake", "empty.vdb", dqj::EmptyResult::Bake, true},
+                             Case{"mesh", "empty.ply", dqj::EmptyResult::Mesh, true},
+                             Case{"povray", "empty.pov", dqj::EmptyResult::Povray, false}}) {
+        const Outcome result = run(item.command + " -q -p '" + file + "' -o '" + path(item.output) + "'");
+        EXPECT_EQ(result.exitCode, 0) << item.command << ": " << result.err;
+        const std::string name = item.command.substr(0, item.command.find(' '));
+        const std::string expected =
+            "dqjulia " + name +
+            ": warning: " + dqj::emptyResultMessage(item.kind, reason, item.named ? path(item.output) : "") + "\n";
+        EXPECT_EQ(result.err, expected) << item.command;  // said once, in the one wording
+    }
+
+    dqj_context context = nullptr;
+    ASSERT_EQ(dqj_context_create(&context), DQJ_OK);
+    ASSERT_EQ(dqj_context_load_params_file(context, file.c_str()), DQJ_OK) << dqj_context_error(context);
+    std::vector<uint8_t> pixels(32 * 24 * 4);
+    ASSERT_EQ(dqj_render_rgba8(context, pixels.data(), 32, 24, 32 * 4, nullptr, nullptr), DQJ_OK);
+    EXPECT_EQ(std::string(dqj_context_warning(context)), dqj::emptyResultMessage(dqj::EmptyResult::Render, reason));
+    ASSERT_EQ(dqj_bake_vdb(context, path("abi.vdb").c_str(), nullptr, nullptr), DQJ_OK) << dqj_context_error(context);
+    EXPECT_EQ(std::string(dqj_context_warning(context)), dqj::emptyResultMessage(dqj::EmptyResult::Bake, reason));
+    ASSERT_EQ(dqj_mesh_compute(context, nullptr, nullptr), DQJ_OK) << dqj_context_error(context);
+    EXPECT_EQ(std::string(dqj_context_warning(context)), dqj::emptyResultMessage(dqj::EmptyResult::Mesh, reason));
+    dqj_context_destroy(context);
+
+    // Without a known reason, each kind says what to try.
+    EXPECT_NE(dqj::emptyResultMessage(dqj::EmptyResult::Render, "").find("larger detail"), std::string::npos);
+    EXPECT_NE(dqj::emptyResultMessage(dqj::EmptyResult::Bake, "").find("higher resolution"), std::string::npos);
 }
 
 TEST_F(Cli, ParameterFileAndFlagOverrides) {

@@ -111,6 +111,22 @@ inline pid_t spawnProgram(const std::string& program, const std::vector<std::str
     return status == 0 ? pid : -1;
 }
 
+/// The names a command's --help lists in a section (e.g. "Subcommands:"), one per entry line ("  name  text").
+inline std::vector<std::string> helpSection(const std::string& help, const std::string& section) {
+    std::vector<std::string> names;
+    std::istringstream lines(help);
+    bool inside = false;
+    for (std::string line; std::getline(lines, line);) {
+        if (line.rfind(section, 0) == 0) {
+            inside = true;
+            continue;
+        }
+        if (inside && (line.empty() || line[0] != ' ')) inside = false;
+        if (inside && line.size() > 2 && line[2] != ' ') names.push_back(line.substr(2, line.find(' ', 2) - 2));
+    }
+    return names;
+}
+
 /// The names of the files in a folder, sorted.
 inline std::vector<std::string> fileNames(const std::filesystem::path& folder) {
     std::vector<std::string> names;

@@ -41,23 +41,6 @@ struct TextOption {
     bool positional = false;
 };
 
-/// The names of a help text's section (e.g. "Subcommands:"), one per entry line ("  name  text").
-std::vector<std::string> sectionNames(const std::string& help, const std::string& section) {
-    std::vector<std::string> names;
-    std::istringstream lines(help);
-    std::string line;
-    bool inside = false;
-    while (std::getline(lines, line)) {
-        if (line.rfind(section, 0) == 0) {
-            inside = true;
-            continue;
-        }
-        if (inside && (line.empty() || line[0] != ' ')) inside = false;
-        if (inside && line.size() > 2 && line[2] != ' ') names.push_back(line.substr(2, line.find(' ', 2) - 2));
-    }
-    return names;
-}
-
 /// The options and positionals of a command's --help whose value is text (CLI11 writes TEXT, TEXT:FILE, ...).
 std::vector<TextOption> textOptions(const std::string& help) {
     std::vector<TextOption> options;
@@ -114,10 +97,10 @@ TEST_F(Messages, EveryTextFlagOfEveryCommandIsEscapedInEveryMessage) {
     };
     // The commands, from the help (a command with subcommands of its own is its subcommands).
     std::vector<std::string> commands;
-    const std::vector<std::string> top = sectionNames(run({"--help"}).out, "Subcommands:");
+    const std::vector<std::string> top = dqj::test::helpSection(run({"--help"}).out, "Subcommands:");
     ASSERT_GE(top.size(), 10u);
     for (const std::string& command : top) {
-        const std::vector<std::string> sub = sectionNames(run({command, "--help"}).out, "Subcommands:");
+        const std::vector<std::string> sub = dqj::test::helpSection(run({command, "--help"}).out, "Subcommands:");
         if (sub.empty()) commands.push_back(command);
         for (const std::string& name : sub) commands.push_back(command + " " + name);
     }

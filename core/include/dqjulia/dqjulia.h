@@ -103,8 +103,8 @@ DQJ_API dqj_status dqj_context_destroy(dqj_context context);
 /* The message of the context's last failed call ("" if none). Valid until the next call on
  * the context. For an invalid handle, a static text saying so. */
 DQJ_API const char* dqj_context_error(dqj_context context);
-/* A warning from the context's last successful call ("" if none): for example why a render
- * found no surface (the slice is empty, and what to change). */
+/* A warning from the context's last successful call ("" if none): for example why a render,
+ * bake or mesh found no surface ("the image shows no surface: " and why, or what to change). */
 DQJ_API const char* dqj_context_warning(dqj_context context);
 
 /* Parameters: the JSON document of the parameter file (see README), whole or in part;

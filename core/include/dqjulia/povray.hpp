@@ -14,6 +14,7 @@
 // spread over TBB threads.
 #pragma once
 
+#include <array>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -42,6 +43,11 @@ struct DensityGrid {
     /// unit (from each cell's largest edge differences along each axis): the isosurface's max_gradient.
     double maxGradient = 0.0;
 };
+
+/// The DF3 grid's limits: samples per axis (a 512^3 grid holds 134 million samples) and the
+/// bits a sample may have.
+inline constexpr int kMinDf3Resolution = 2, kMaxDf3Resolution = 512;
+inline constexpr std::array<int, 3> kDf3Bits{8, 16, 32};
 
 /// Samples the parameter set's distance estimate on a resolution^3 grid over the cube around
 /// the render bounds. Throws ParamError for invalid parameters or a resolution outside

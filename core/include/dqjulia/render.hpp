@@ -49,6 +49,10 @@ struct RenderStats {
 struct RenderResult {
     Image image;
     RenderStats stats;
+    /// Why no pixel shows the surface (stats.hitPixels == 0): the slice's proven emptiness
+    /// (provenEmptyReason), else inspect()'s reason from sampling; "" when pixels were hit or no
+    /// reason is known. emptyResultMessage (empty_result.hpp) words it.
+    std::string emptyReason;
 };
 
 /// How the renderer evaluates the fractal. Both run the same marching and shading logic.

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <string_view>
@@ -78,5 +79,9 @@ DQJ_API std::string schemaJson();
 
 /// The file's name of a choice field's value: choiceName("fractal.variant", 1) = "paper-coupled".
 DQJ_API std::string_view choiceName(std::string_view key, int index);
+/// The index (the C++ enum's value) of a choice by its name in the file: choiceIndex(field("fractal.variant"),
+/// "dual") = 2; nullopt when the field has no choice of that name. The one way from a name to an enum value:
+/// the file's reader and the command's flags both take it.
+DQJ_API std::optional<int> choiceIndex(const Field& field, std::string_view name);
 
 }  // namespace dqj::schema

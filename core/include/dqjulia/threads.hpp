@@ -14,6 +14,9 @@ namespace dqj {
 /// a scheduler's binding), else every hardware thread.
 DQJ_API int defaultThreadCount();
 
+/// The most threads a command lets a task ask for (--threads, --cpus-per-task).
+inline constexpr int kMaxThreadCount = 4096;
+
 /// While it lives, the core's parallel work uses at most `threads` threads (at least 1).
 class DQJ_API ThreadLimit {
 public:
