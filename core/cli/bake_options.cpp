@@ -9,8 +9,8 @@
 #endif
 
 #include "dqjulia/threads.hpp"
-#include "file_names.hpp"
-#include "message_text.hpp"
+#include "files/file_names.hpp"
+#include "files/message_text.hpp"
 #include "schema_options.hpp"
 
 #include <cmath>

@@ -23,9 +23,9 @@
 #include "dqjulia/bake.hpp"
 #include "dqjulia/params.hpp"
 #include "dqjulia/tiles.hpp"
-#include "sparse_sampler.hpp"  // bakeIndexBox, bakeVoxelSize (internal)
+#include "bake/sparse_sampler.hpp"  // bakeIndexBox, bakeVoxelSize (internal)
 #include "test_support.hpp"
-#include "tile_geometry.hpp"  // tileWindow (internal)
+#include "bake/tile_geometry.hpp"  // tileWindow (internal)
 
 namespace dqj::test {
 

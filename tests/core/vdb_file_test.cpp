@@ -12,12 +12,12 @@
 
 #include <openvdb/openvdb.h>
 
-#include "atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "dqjulia/bake.hpp"
 #include "dqjulia/params.hpp"
 #include "dqjulia/tiles.hpp"
 #include "test_support.hpp"
-#include "vdb_file.hpp"
+#include "files/vdb_file.hpp"
 
 namespace fs = std::filesystem;
 using namespace dqj;

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "test_support.hpp"
 
 namespace fs = std::filesystem;
