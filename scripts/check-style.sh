@@ -75,7 +75,7 @@ else
   while read -r file range; do
     [ -f "$file" ] || continue
     [ -n "${ranges[$file]+set}" ] || files+=("$file")
-    ranges[$file]="${ranges[$file]:-}$range"
+    ranges[$file]="${ranges[$file]:-}${range:+$range }"
   done < <(git diff -U0 -M --no-color --diff-filter=d "$base" |
     awk '/^\+\+\+ / { file = substr($0, 7); print file, ""; next }
          /^@@ / { split($3, new, ","); n = (new[2] == "") ? 1 : new[2]; first = substr(new[1], 2)

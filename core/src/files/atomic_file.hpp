@@ -23,7 +23,7 @@
 #include <vector>
 
 #include "dqjulia/params.hpp"  // Existing
-#include "files/message_text.hpp"    // printableText, inputExcerpt
+#include "files/message_text.hpp"  // printableText, inputExcerpt
 
 namespace dqj {
 
