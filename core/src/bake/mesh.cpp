@@ -24,6 +24,7 @@
 #include "dqjulia/image.hpp"
 #include "dqjulia/coloring.hpp"
 #include "bake/level_set.hpp"
+#include "bake/memory.hpp"
 #include "platform/parallel_progress.hpp"
 #include "platform/thread_scratch.hpp"
 
@@ -31,16 +32,6 @@ namespace dqj {
 namespace {
 
 constexpr std::size_t kVerticesPerTask = 4096;
-
-/// Memory per sampled 8^3 leaf beyond the sampled leaf itself: volumeToMesh's masks and polygon
-/// pools, and the mesh's arrays. Measured on the default fractal (peak RSS minus the 65 MB of a
-/// tiny mesh, over sampled leaves: 3.0 kB at 256^3, 5.6 kB at 512^3) and doubled for headroom.
-MemoryModel meshMemoryModel() {
-    MemoryModel model;
-    model.fixedBytes = 96.0 * 1024 * 1024;
-    model.bytesPerLeaf = 10.0 * 1024;
-    return model;
-}
 
 /// The distinct corners of a polygon in order (a repeated neighbour collapses), or 0 when the
 /// polygon is pinched (a corner repeated apart from its neighbours).

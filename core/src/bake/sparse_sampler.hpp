@@ -23,6 +23,7 @@
 #include "dqjulia/batch.hpp"
 #include "dqjulia/params.hpp"
 #include "dqjulia/slice.hpp"
+#include "bake/memory.hpp"
 #include "bake/staged_progress.hpp"
 #include "platform/thread_scratch.hpp"
 
@@ -93,12 +94,6 @@ private:
 struct SampledSurface {
     openvdb::FloatGrid::Ptr grid;
     BakeStats stats;  ///< evaluated, dense, sampledLeaves, interiorLeaves, estimatedBytes, voxelSize
-};
-
-/// Bytes the caller's later stages need per sampled leaf, for the memory estimate.
-struct MemoryModel {
-    double bytesPerLeaf = 0.0;
-    double fixedBytes = 0.0;
 };
 
 /// The voxel size of the bake: the bounds' largest side / bake.resolution.

@@ -1,6 +1,7 @@
 // image_writer.hpp - an image written into an AtomicFile the caller publishes, alone or with the
 // other files of its run (AtomicFileSet). Internal to libdqjulia and the command; writeImage()
 // (dqjulia/image.hpp) is this and commit().
+// Code: image.cpp.
 #pragma once
 
 #include "files/atomic_file.hpp"
