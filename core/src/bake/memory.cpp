@@ -153,7 +153,6 @@ std::uint64_t peakMemoryBytes() {
 #endif
 }
 
-
 std::string formatBytes(std::uint64_t bytes) {
     char text[32];
     const double value = double(bytes);
