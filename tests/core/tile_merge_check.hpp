@@ -24,7 +24,7 @@
 #include "dqjulia/params.hpp"
 #include "dqjulia/tiles.hpp"
 #include "bake/sparse_sampler.hpp"  // bakeIndexBox, bakeVoxelSize (internal)
-#include "bake/tile_geometry.hpp"  // tileWindow (internal)
+#include "bake/tile_geometry.hpp"   // tileWindow (internal)
 #include "bake_fixture.hpp"
 
 namespace dqj::test {

@@ -55,13 +55,13 @@ struct TileStats {
 struct TileBuffers {
     Evaluator evaluator;
     std::vector<RayJob> jobs;
-    std::vector<ShadowMarch> shadowSlots;  // the jobs' shadow marches (RayJob's `shadows`)
-    std::vector<double> columnX;           // image plane x of the tile's sub-pixel columns
-    std::vector<double> rowY;              // and y of its rows
+    std::vector<ShadowMarch> shadowSlots;     // the jobs' shadow marches (RayJob's `shadows`)
+    std::vector<double> columnX;              // image plane x of the tile's sub-pixel columns
+    std::vector<double> rowY;                 // and y of its rows
     std::vector<glm::dvec3> rowBackground;    // and the background of each row
     std::vector<glm::dvec3> pixelBackground;  // per pixel row: a pixel's colour if no sample hits
-    std::vector<double> starts;            // per cone block: where its rays start (+inf: all miss)
-    std::vector<std::size_t> firstJob;     // per pixel of the pass: its first job, or kNoJob
+    std::vector<double> starts;               // per cone block: where its rays start (+inf: all miss)
+    std::vector<std::size_t> firstJob;        // per pixel of the pass: its first job, or kNoJob
 };
 
 /// One tile of the image and how its pixels are sampled: S x S rays a pixel, their colours
@@ -282,8 +282,8 @@ TileStats renderTile(const Scene& scene, RenderEngine engine, int x0, int y0, in
     const int pixelsPerPass = std::max(1, kRaysPerPass / tile.perPixel);
     // Room for the shadow marches of a pass's rays: job k has the lights' slots from k * lights.
     std::vector<ShadowMarch>& shadowSlots = buffers.shadowSlots;
-    shadowSlots.resize(std::max(shadowSlots.size(),
-                                static_cast<std::size_t>(pixelsPerPass) * tile.perPixel * scene.lightCount()));
+    shadowSlots.resize(
+        std::max(shadowSlots.size(), static_cast<std::size_t>(pixelsPerPass) * tile.perPixel * scene.lightCount()));
     prepareTileRays(scene, tile, buffers);
     conePrePass(scene, engine, tile, buffers);
     for (int first = 0; first < tile.pixels(); first += pixelsPerPass) {
