@@ -24,21 +24,21 @@
 namespace dqj {
 namespace {
 
-constexpr int kOcclusionSamples = 5;
-constexpr int kShadowSteps = 64;    // soft shadows are a look, not a measurement: cap their cost
+inline constexpr int kOcclusionSamples = 5;
+inline constexpr int kShadowSteps = 64;  // soft shadows are a look, not a measurement: cap their cost
 /// Shadow marches step by this many DEs (over-relaxed; the DE is about half the distance) and
 /// fall back to the plain step where two consecutive free balls do not overlap.
-constexpr double kShadowRelaxation = 1.6;
-constexpr int kBisectionSteps = 8;  // refines a step that landed inside to 1/256 of the step
+inline constexpr double kShadowRelaxation = 1.6;
+inline constexpr int kBisectionSteps = 8;  // refines a step that landed inside to 1/256 of the step
 /// A cone stops where its free margin (DE minus its radius) drops below this many hit
 /// thresholds: its rays then start well before any point where they could stop.
-constexpr double kConeMargin = 4.0;
+inline constexpr double kConeMargin = 4.0;
 
 /// The normal turned towards the eye. A gradient that tips past perpendicular to the ray (a
 /// surface seen edge on, where the differences straddle a crease) is bent back onto the
 /// silhouette, its component along the ray removed, not mirrored: mirroring turned a lit grazing
 /// surface into a dark speckle one pixel wide. A normal pointing straight away becomes -ray.
-glm::dvec3 facingRay(const glm::dvec3& normal, const glm::dvec3& direction) {
+inline glm::dvec3 facingRay(const glm::dvec3& normal, const glm::dvec3& direction) {
     const double along = glm::dot(normal, direction);
     if (along <= 0.0) return normal;
     const glm::dvec3 bent = normal - along * direction;

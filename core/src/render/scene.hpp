@@ -19,8 +19,8 @@
 namespace dqj {
 namespace {
 
-constexpr double kInfinity = std::numeric_limits<double>::infinity();
-constexpr double kFootprintFloor = 1e-7;
+inline constexpr double kInfinity = std::numeric_limits<double>::infinity();
+inline constexpr double kFootprintFloor = 1e-7;
 
 /// What the renderer reads of an evaluation: Escape without the exit state, small enough to pass
 /// around by the million.
