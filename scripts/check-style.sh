@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Checks the code against the project's style: clang-format (.clang-format) on C and C++,
 # ruff (ruff.toml: lint and format) on the Python of blender_addon/, python/, scripts/ and tests/,
-# mypy (mypy.ini) on the typed modules, and clang-tidy (.clang-tidy) on C and C++ sources with
-# build/compile_commands.json.
+# mypy (mypy.ini) on the typed modules, clang-tidy (.clang-tidy) on C and C++ sources with
+# build/compile_commands.json, and the layout of core/src (scripts/check-layout.py: includes between
+# its folders run one way).
 #
 #   scripts/check-style.sh          the lines changed since the base: what a commit must keep clean
 #   scripts/check-style.sh --all    every file, every line (the tree is not reformatted yet)
@@ -69,14 +70,19 @@ else
     echo "check-style: no base commit to compare with (set DQJ_STYLE_BASE, or use --all): nothing checked"
     exit 0
   fi
-  while IFS= read -r file; do
+  # New lines of each hunk, from "@@ -a,b +c,d @@" (d = 0: lines only removed), in one diff with
+  # rename detection (-M), so a moved file's changed lines are its edits, not all its lines.
+  while read -r file range; do
     [ -f "$file" ] || continue
-    files+=("$file")
-    # New lines of each hunk, from "@@ -a,b +c,d @@" (d = 0: lines only removed).
-    ranges[$file]="$(git diff -U0 --no-color "$base" -- "$file" |
-      sed -n 's/^@@ -[0-9,]* +\([0-9]*\)\(,\([0-9]*\)\)\? @@.*/\1 \3/p' |
-      awk '{ n = ($2 == "") ? 1 : $2; if (n > 0) printf "%d:%d ", $1, $1 + n - 1 }')"
-  done < <(git diff --name-only --diff-filter=d "$base"; git ls-files --others --exclude-standard)
+    [ -n "${ranges[$file]+set}" ] || files+=("$file")
+    ranges[$file]="${ranges[$file]:-}${range:+$range }"
+  done < <(git diff -U0 -M --no-color --diff-filter=d "$base" |
+    awk '/^\+\+\+ / { file = substr($0, 7); print file, ""; next }
+         /^@@ / { split($3, new, ","); n = (new[2] == "") ? 1 : new[2]; first = substr(new[1], 2)
+                  if (n > 0) printf "%s %d:%d \n", file, first, first + n - 1 }')
+  while IFS= read -r file; do
+    [ -f "$file" ] && [ -z "${ranges[$file]+set}" ] && files+=("$file")
+  done < <(git ls-files --others --exclude-standard)
   for file in $(git ls-files --others --exclude-standard); do
     ranges[$file]="1:$(($(wc -l < "$file") + 1))"
   done
@@ -109,7 +115,7 @@ fi
 
 # The project's own rule: no thread_local with a destructor in the library or the command. With
 # MinGW-w64 one corrupts the heap when its thread exits (GCC bug 80816); per-thread buffers are
-# ThreadScratch (core/src/thread_scratch.hpp). A thread_local of a trivially destructible type says
+# ThreadScratch (core/src/platform/thread_scratch.hpp). A thread_local of a trivially destructible type says
 # so on its line or the line before ("trivially destructible").
 in_ranges() {  # in_ranges FILE LINE: whether LINE is among FILE's changed lines (always with --all)
   [ "$mode" = all ] && return 0
@@ -223,6 +229,11 @@ if [ ${#cxx[@]} -gt 0 ] && [ "$mode" != fix ]; then
     fi
   fi
 fi
+
+# The layout: includes between the folders of core/src run one way (CONTRIBUTING.md, Layout);
+# the whole tree each time (it takes a moment), and the check's own self-test.
+python3 scripts/check-layout.py || failed=1
+python3 scripts/check-layout.py --self-test >/dev/null || { python3 scripts/check-layout.py --self-test; failed=1; }
 
 if [ "$failed" -ne 0 ]; then
   echo "check-style: FAILED (scripts/check-style.sh --fix reformats the changed lines; CONTRIBUTING.md, Style)" >&2

@@ -1,7 +1,7 @@
 """The slice as the preview shader needs it: the 8-D origin and axes after the rotations,
 and the slice's largest stretch. Pure Python (no bpy), read from a parameter document.
 
-This mirrors core/src/slice.cpp (rotated(), stretchOf()); the Blender tests hold the two
+This mirrors core/src/kernel/slice.cpp (rotated(), stretchOf()); the Blender tests hold the two
 equal by mapping points both ways (dqj_evaluate_slice_points against dqj_evaluate_points
 at the points mapped here). Bounds and emptiness are not recomputed here: they come from
 the core (dqj_inspect_json).

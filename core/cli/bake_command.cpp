@@ -12,7 +12,7 @@
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/threads.hpp"
 #include "dqjulia/tiles.hpp"
-#include "message_text.hpp"
+#include "files/message_text.hpp"
 
 namespace dqj::cli {
 namespace {

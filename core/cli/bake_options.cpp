@@ -1,16 +1,8 @@
 #include "bake_options.hpp"
 
-#ifdef _WIN32
-#include <windows.h>
-#define PSAPI_VERSION 2  // GetProcessMemoryInfo from kernel32.dll, not psapi.dll
-#include <psapi.h>
-#else
-#include <sys/resource.h>
-#endif
-
 #include "dqjulia/threads.hpp"
-#include "file_names.hpp"
-#include "message_text.hpp"
+#include "files/file_names.hpp"
+#include "files/message_text.hpp"
 #include "schema_options.hpp"
 
 #include <cmath>
@@ -244,18 +236,6 @@ ProgressCallback bakeProgress(ProgressBar& bar, const BakeMonitor& monitor) {
 std::string evaluatedSummary(const BakeStats& stats) {
     return "evaluated " + shortCount(stats.evaluated) + " of " + shortCount(stats.dense) + " voxels (" +
            percent(stats.evaluated, stats.dense) + ")";
-}
-
-/// The process's peak resident memory.
-std::uint64_t peakMemoryBytes() {
-#ifdef _WIN32
-    PROCESS_MEMORY_COUNTERS counters{};
-    return ::GetProcessMemoryInfo(::GetCurrentProcess(), &counters, sizeof counters) ? counters.PeakWorkingSetSize : 0;
-#else
-    rusage usage{};
-    ::getrusage(RUSAGE_SELF, &usage);
-    return std::uint64_t(usage.ru_maxrss) * 1024;
-#endif
 }
 
 void printBakeStats(const BakeStats& stats) {

@@ -14,6 +14,8 @@
 #include "dqjulia/params.hpp"
 #include "dqjulia/tiles.hpp"
 
+#include "bake/memory.hpp"  // peakMemoryBytes (internal)
+
 namespace dqj::cli {
 
 /// An inclusive range of whole frames (--frames A-B, or A alone).
@@ -83,7 +85,5 @@ std::string evaluatedSummary(const BakeStats& stats);
 
 /// The lines --stats prints for one bake (stdout), peak memory included.
 void printBakeStats(const BakeStats& stats);
-/// The process's peak resident memory, in bytes (0 where the system does not say).
-std::uint64_t peakMemoryBytes();
 
 }  // namespace dqj::cli

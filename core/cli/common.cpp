@@ -15,10 +15,10 @@
 #include <map>
 #include <system_error>
 
-#include "atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "dqjulia/estimate.hpp"
-#include "file_names.hpp"
-#include "message_text.hpp"
+#include "files/file_names.hpp"
+#include "files/message_text.hpp"
 #include "schema_options.hpp"
 
 namespace dqj::cli {

@@ -5,8 +5,8 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "dqjulia/estimate.hpp"
-#include "message_text.hpp"
-#include "text_input.hpp"
+#include "files/message_text.hpp"
+#include "files/text_input.hpp"
 
 namespace dqj::cli {
 namespace {

@@ -8,11 +8,11 @@
 #include "common.hpp"
 #include "contact_sheet.hpp"
 #include "explore.hpp"
-#include "atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "dqjulia/render.hpp"
-#include "file_names.hpp"
-#include "image_writer.hpp"
-#include "message_text.hpp"
+#include "files/file_names.hpp"
+#include "render/image_writer.hpp"
+#include "files/message_text.hpp"
 
 namespace dqj::cli {
 namespace {

@@ -28,14 +28,14 @@
 
 #include <nlohmann/json.hpp>
 
-#include "atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "bake_options.hpp"
 #include "commands.hpp"
 #include "common.hpp"
 #include "dqjulia/dqjulia.h"
 #include "dqjulia/threads.hpp"
 #include "dqjulia/tiles.hpp"
-#include "file_names.hpp"
+#include "files/file_names.hpp"
 #include "job_files.hpp"
 
 namespace dqj::cli {

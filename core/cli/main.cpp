@@ -12,7 +12,7 @@
 #include "commands.hpp"
 #include "common.hpp"
 #include "dqjulia/dqjulia.h"
-#include "message_text.hpp"
+#include "files/message_text.hpp"
 
 namespace {
 

@@ -9,8 +9,8 @@
 #include "common.hpp"
 #include "dqjulia/threads.hpp"
 #include "dqjulia/tiles.hpp"
-#include "file_names.hpp"
-#include "message_text.hpp"
+#include "files/file_names.hpp"
+#include "files/message_text.hpp"
 
 namespace dqj::cli {
 namespace {

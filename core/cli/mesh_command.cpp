@@ -10,7 +10,7 @@
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/mesh.hpp"
 #include "dqjulia/threads.hpp"
-#include "message_text.hpp"
+#include "files/message_text.hpp"
 
 namespace dqj::cli {
 namespace {

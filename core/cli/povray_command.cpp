@@ -9,10 +9,10 @@
 #include "dqjulia/empty_result.hpp"
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/povray.hpp"
-#include "file_names.hpp"
-#include "message_text.hpp"
+#include "files/file_names.hpp"
+#include "files/message_text.hpp"
+#include "files/text_input.hpp"
 #include "schema_options.hpp"
-#include "text_input.hpp"
 
 namespace dqj::cli {
 namespace {

@@ -8,7 +8,7 @@
 #include "dqjulia/image.hpp"
 #include "dqjulia/empty_result.hpp"
 #include "dqjulia/render.hpp"
-#include "image_writer.hpp"
+#include "render/image_writer.hpp"
 #include "schema_options.hpp"
 #include "voxel_render.hpp"
 

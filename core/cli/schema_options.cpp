@@ -5,8 +5,8 @@
 #include <cstdlib>
 
 #include "dqjulia/param_file.hpp"
-#include "json_text.hpp"
-#include "param_check.hpp"
+#include "params/json_text.hpp"
+#include "params/param_check.hpp"
 
 namespace dqj::cli {
 namespace {

@@ -13,9 +13,9 @@
 #include <openvdb/openvdb.h>
 
 #include "dqjulia/coloring.hpp"
-#include "message_text.hpp"
-#include "parallel_progress.hpp"
-#include "vdb_file.hpp"
+#include "files/message_text.hpp"
+#include "platform/parallel_progress.hpp"
+#include "files/vdb_file.hpp"
 
 namespace dqj {
 namespace {

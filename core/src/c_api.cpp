@@ -23,7 +23,7 @@
 #include "dqjulia/mesh.hpp"
 #include "dqjulia/params.hpp"
 #include "dqjulia/render.hpp"
-#include "message_text.hpp"
+#include "files/message_text.hpp"
 
 struct dqj_context_t {
     dqj::Params params;

@@ -11,6 +11,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -135,6 +136,23 @@ inline std::vector<std::string> fileNames(const std::filesystem::path& folder) {
     std::sort(names.begin(), names.end());
     return names;
 }
+
+/// The fixture of a test that works in a folder of its own: "<temp>/dqjulia_<suite>_<pid>_<test>"
+/// (freshTestFolder), made before the test and removed after it. Suites use it by name
+/// (`using Scratch = ScratchFolder;`) or derive from it (bake_fixture.hpp's BakeFolder).
+class ScratchFolder : public ::testing::Test {
+public:
+    void SetUp() override {
+        std::string suite = ::testing::UnitTest::GetInstance()->current_test_info()->test_suite_name();
+        for (char& c : suite)
+            if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+        dir_ = freshTestFolder("dqjulia_" + suite);
+    }
+    void TearDown() override { std::filesystem::remove_all(dir_); }
+    std::string path(const std::string& name) const { return (dir_ / name).string(); }
+    std::vector<std::string> files() const { return fileNames(dir_); }
+    std::filesystem::path dir_;
+};
 
 /// mt19937_64 is specified exactly by the standard, its distributions are not: the bits are
 /// mapped here, so every platform tests the same points.

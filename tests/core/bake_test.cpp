@@ -1,6 +1,6 @@
 // Baking: the VDB read back with OpenVDB, the c = 0 ball, sparse against dense, the mesh's
-// geometry and topology, the ball bound, keyframes, interruption and the memory limit, and the
-// C ABI's bake and mesh calls.
+// geometry and topology, interruption and the memory limit. (The ball bound: ball_bound_test.cpp;
+// keyframes: keyframes_test.cpp; the C ABI's bake and mesh calls: c_api_bake_test.cpp.)
 #include <gtest/gtest.h>
 
 #include <unistd.h>
@@ -22,10 +22,9 @@
 #include "dqjulia/coloring.hpp"
 #include "dqjulia/estimate.hpp"
 #include "dqjulia/slice.hpp"
-#include "dqjulia/ball_bound.hpp"
-#include "dqjulia/dqjulia.h"
 #include "dqjulia/mesh.hpp"
 #include "dqjulia/params.hpp"
+#include "bake_fixture.hpp"
 #include "test_support.hpp"
 
 namespace fs = std::filesystem;
@@ -33,27 +32,8 @@ using namespace dqj;
 
 namespace {
 
-class Bake : public ::testing::Test {
-protected:
-    static void SetUpTestSuite() { openvdb::initialize(); }
-    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_bake"); }
-    void TearDown() override { fs::remove_all(dir_); }
-    std::string path(const std::string& name) const { return (dir_ / name).string(); }
-    std::vector<std::string> files() const { return dqj::test::fileNames(dir_); }
-    fs::path dir_;
-};
-
-std::map<std::string, openvdb::GridBase::Ptr> readGrids(const std::string& path,
-                                                        openvdb::MetaMap::Ptr* metadata = nullptr) {
-    openvdb::io::File file(path);
-    file.open();
-    std::map<std::string, openvdb::GridBase::Ptr> grids;
-    const openvdb::GridPtrVecPtr all = file.getGrids();
-    for (const openvdb::GridBase::Ptr& grid : *all) grids[grid->getName()] = grid;
-    if (metadata) *metadata = file.getMetadata();
-    file.close();
-    return grids;
-}
+using Bake = dqj::test::BakeFolder;
+using dqj::test::readVdb;
 
 /// c = 0: the set is the unit ball. A box around it, so the bounds do not cut the surface.
 Params unitBall(int resolution) {
@@ -77,8 +57,9 @@ TEST_F(Bake, TheFileHoldsNamedGridsOfTheRightClassAndTransform) {
     const BakeStats stats = bakeVdb(params, path("f.vdb"));
     EXPECT_EQ(files(), std::vector<std::string>{"f.vdb"});  // no temporary left
 
-    openvdb::MetaMap::Ptr metadata;
-    auto grids = readGrids(path("f.vdb"), &metadata);
+    const dqj::test::VdbFile file = readVdb(path("f.vdb"));
+    const openvdb::MetaMap::Ptr metadata = file.metadata;
+    auto grids = file.grids;
     ASSERT_EQ(grids.size(), 5u);
     auto surface = openvdb::gridPtrCast<openvdb::FloatGrid>(grids["surface"]);
     auto density = openvdb::gridPtrCast<openvdb::FloatGrid>(grids["density"]);
@@ -126,7 +107,7 @@ TEST_F(Bake, ColoursReachBelowTheSurfaceToTheColourDepth) {
     params.bake.grids = {BakeGrid::Surface, BakeGrid::Density, BakeGrid::Color};
     params.bake.colorDepth = 0.08;
     const BakeStats stats = bakeVdb(params, path("c.vdb"));
-    auto grids = readGrids(path("c.vdb"));
+    auto grids = readVdb(path("c.vdb")).grids;
     auto surface = openvdb::gridPtrCast<openvdb::FloatGrid>(grids["surface"]);
     auto color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(grids["color"]);
     ASSERT_TRUE(surface && color);
@@ -152,7 +133,7 @@ TEST_F(Bake, ColoursReachBelowTheSurfaceToTheColourDepth) {
     // The default depth (0.02 of 100 = 2 voxels) is less than the band: the band alone.
     params.bake.colorDepth = 0.02;
     bakeVdb(params, path("d.vdb"));
-    auto band = openvdb::gridPtrCast<openvdb::Vec3SGrid>(readGrids(path("d.vdb"))["color"]);
+    auto band = openvdb::gridPtrCast<openvdb::Vec3SGrid>(readVdb(path("d.vdb")).grids["color"]);
     EXPECT_EQ(band->activeVoxelCount(), surface->activeVoxelCount());
     EXPECT_GT(color->activeVoxelCount(), 3 * band->activeVoxelCount() / 2);  // the band is 6 voxels thick
 }
@@ -166,7 +147,7 @@ TEST_F(Bake, BelowTheSurfaceTheColourIsTheSurfaces) {
     params.bake.colorDepth = 0.05;
     const BakeStats stats = bakeVdb(params, path("c.vdb"));
     const Mesh mesh = bakeMesh(params);
-    auto color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(readGrids(path("c.vdb"))["color"]);
+    auto color = openvdb::gridPtrCast<openvdb::Vec3SGrid>(readVdb(path("c.vdb")).grids["color"]);
     ASSERT_TRUE(color);
     const double h = stats.voxelSize;
     const Slice slice = params.slice.effective();
@@ -198,7 +179,7 @@ TEST_F(Bake, TheSurfaceOfCZeroIsTheUnitSphereWithinAVoxel) {
     const BakeStats stats = bakeVdb(params, path("ball.vdb"));
     const double h = stats.voxelSize;
     EXPECT_NEAR(h, 3.0 / 64, 1e-12);
-    auto surface = openvdb::gridPtrCast<openvdb::FloatGrid>(readGrids(path("ball.vdb"))["surface"]);
+    auto surface = openvdb::gridPtrCast<openvdb::FloatGrid>(readVdb(path("ball.vdb")).grids["surface"]);
     ASSERT_TRUE(surface);
     // Every value of the narrow band is the signed distance to the unit sphere to within a voxel.
     std::size_t count = 0;
@@ -225,8 +206,8 @@ TEST_F(Bake, SparseAndDenseEvaluationGiveTheSameSurface) {
         dense.dense = true;
         bakeVdb(params, path("sparse.vdb"));
         bakeVdb(params, path("dense.vdb"), dense);
-        auto sparse = openvdb::gridPtrCast<openvdb::FloatGrid>(readGrids(path("sparse.vdb"))["surface"]);
-        auto denseGrid = openvdb::gridPtrCast<openvdb::FloatGrid>(readGrids(path("dense.vdb"))["surface"]);
+        auto sparse = openvdb::gridPtrCast<openvdb::FloatGrid>(readVdb(path("sparse.vdb")).grids["surface"]);
+        auto denseGrid = openvdb::gridPtrCast<openvdb::FloatGrid>(readVdb(path("dense.vdb")).grids["surface"]);
         ASSERT_GT(sparse->activeVoxelCount(), 100u);
         EXPECT_EQ(sparse->activeVoxelCount(), denseGrid->activeVoxelCount()) << variantName(variant);
         auto other = denseGrid->getConstAccessor();
@@ -372,245 +353,6 @@ TEST_F(Bake, SparseCostGrowsWithTheSurface) {
     const double growth = double(high.evaluated) / double(low.evaluated);
     EXPECT_LT(growth, 5.2) << low.evaluated << " -> " << high.evaluated;
     EXPECT_EQ(high.dense, 8 * low.dense);
-}
-
-TEST(BallBound, EveryPointOfAProvenBallEscapesWithADeAboveTheBound) {
-    std::mt19937 random(7);
-    std::uniform_real_distribution<double> unit(-1.0, 1.0);
-    int proven = 0;
-    for (const Variant variant : {Variant::Paper, Variant::PaperCoupled, Variant::Dual}) {
-        Fractal fractal;
-        fractal.variant = variant;
-        fractal.bailout = minimumBailout(fractal) + 0.5;
-        for (int trial = 0; trial < 300; ++trial) {
-            DualQuat centre;
-            for (int index = 0; index < 8; ++index)
-                component(centre, index) = 1.6 * unit(random) * (index < 4 ? 1.0 : 0.3);
-            const double radius = 0.05 * (1 + trial % 4);
-            const BallBound bound = boundBall(fractal, centre, radius, radius);
-            if (!bound.allEscape) continue;
-            ++proven;
-            for (int sample = 0; sample < 40; ++sample) {
-                DualQuat q = centre;
-                // A point of the ball (each part within the radius).
-                double a[4], b[4], na = 0, nb = 0;
-                for (int k = 0; k < 4; ++k) na += (a[k] = unit(random)) * a[k], nb += (b[k] = unit(random)) * b[k];
-                const double sa = radius * std::abs(unit(random)) / std::sqrt(na),
-                             sb = radius * std::abs(unit(random)) / std::sqrt(nb);
-                for (int k = 0; k < 4; ++k) component(q, k) += sa * a[k], component(q, 4 + k) += sb * b[k];
-                const Escape escape = evaluate(fractal, q);
-                ASSERT_NE(escape.n, 0) << variantName(variant);
-                ASSERT_GE(escape.de, bound.minDe * (1 - 1e-9)) << variantName(variant);
-            }
-        }
-    }
-    EXPECT_GT(proven, 100);
-}
-
-TEST(Animation, KeyframesInterpolateLinearlyAndSmoothly) {
-    const Params params = parseParams(R"({
-      "slice": {"rotations": [{"plane": "a.j,b.s", "degrees": 0}]},
-      "animation": {
-        "fractal.iterations": [{"frame": 1, "value": 10}, {"frame": 11, "value": 20}],
-        "slice.rotations[0].degrees": [{"frame": 0, "value": 0, "interpolation": "smooth"},
-                                       {"frame": 10, "value": 90, "interpolation": "smooth"},
-                                       {"frame": 20, "value": 100}],
-        "fractal.c": [{"frame": 1, "value": [-0.39054, -0.58679, 0, 0, 0, 0.5632, 0, 0.05]},
-                      {"frame": 5, "value": [-0.2, -0.58679, 0, 0, 0, 0.5632, 0, 0.05]}]
-      }})");
-    EXPECT_EQ(atFrame(params, -3).fractal.iterations, 10);  // before the first key: the first value
-    EXPECT_EQ(atFrame(params, 6).fractal.iterations, 15);
-    EXPECT_EQ(atFrame(params, 6.4).fractal.iterations, 15);  // rounded
-    EXPECT_EQ(atFrame(params, 99).fractal.iterations, 20);
-    EXPECT_NEAR(scalarPart(atFrame(params, 3).fractal.c.a), -0.29527, 1e-12);
-    // Smooth: through the keys, flat at the ends, never overshooting, rising monotonically.
-    auto degrees = [&](double frame) { return atFrame(params, frame).slice.rotations[0].degrees; };
-    EXPECT_DOUBLE_EQ(degrees(10), 90.0);
-    EXPECT_NEAR(degrees(0.01), 0.0, 1e-3);
-    double previous = -1.0;
-    for (double frame = 0; frame <= 20; frame += 0.25) {
-        EXPECT_GE(degrees(frame), previous);
-        EXPECT_LE(degrees(frame), 100.0);
-        previous = degrees(frame);
-    }
-    EXPECT_LT(degrees(5), 45.0 + 20.0);
-    // The document round-trips.
-    EXPECT_EQ(toJson(parseParams(toJson(params))), toJson(params));
-}
-
-TEST(Animation, BadKeyframesAreRejectedWithTheKey) {
-    const std::vector<std::pair<std::string, std::string>> cases = {
-        {R"({"animation": {"fractal.iterations": [{"frame": 5, "value": 10}, {"frame": 2, "value": 12}]}})",
-         "frames must increase"},
-        {R"({"animation": {"fractal.variant": [{"frame": 1, "value": 1}]}})", "cannot be animated"},
-        {R"({"animation": {"fractal.iterations": [{"frame": 1, "value": 10.5}]}})", "whole number"},
-        {R"({"animation": {"fractal.c": [{"frame": 1, "value": [1, 2]}]}})", "array of 8 numbers"},
-        {R"({"animation": {"slice.rotations[2].degrees": [{"frame": 1, "value": 3}]}})", "slice.rotations has 0"},
-        {R"({"animation": {"fractal.bailout": [{"frame": 1, "value": 1.2}]}})", "at frame 1"},
-        {R"({"animation": {"fractal.iterations": [{"frame": 1, "value": 10, "interpolation": "cubic"}]}})",
-         "linear, smooth"},
-        {R"({"animation": {"fractal.iterations": []}})", "non-empty array"},
-    };
-    for (const auto& [json, message] : cases) {
-        try {
-            parseParams(json);
-            ADD_FAILURE() << "accepted: " << json;
-        } catch (const ParamError& error) {
-            EXPECT_NE(std::string(error.what()).find(message), std::string::npos) << error.what();
-        }
-    }
-}
-
-TEST(BakeParams, TheBakeSectionRoundTripsAndIsChecked) {
-    const Params params = parseParams(R"({"bake": {"resolution": 96, "bounds": {"min": [-1, -1, -1], "max": [1, 2, 1]},
-        "band_width": 2, "grids": ["density", "color"], "adaptivity": 0.25, "mesh_colors": false}})");
-    EXPECT_EQ(params.bake.resolution, 96);
-    EXPECT_EQ(params.bake.bounds->max.y, 2.0);
-    EXPECT_EQ(params.bake.grids, (std::vector<BakeGrid>{BakeGrid::Density, BakeGrid::Color}));
-    EXPECT_FALSE(params.bake.meshColors);
-    EXPECT_EQ(toJson(parseParams(toJson(params))), toJson(params));
-    const std::vector<std::pair<std::string, std::string>> bad = {
-        {R"({"bake": {"resolution": 4}})", "bake.resolution"},
-        {R"({"bake": {"grids": ["surface", "surface"]}})", "twice"},
-        {R"({"bake": {"grids": ["fog"]}})", "surface, density, color, trap, iterations"},
-        {R"({"bake": {"bounds": {"min": [1, 0, 0], "max": [0, 1, 1]}}})", "min must be below max"},
-        {R"({"bake": {"adaptivity": 2}})", "bake.adaptivity"},
-        {R"({"bake": {"resolutoin": 64}})", "did you mean \"resolution\""},
-    };
-    for (const auto& [json, message] : bad) {
-        try {
-            parseParams(json);
-            ADD_FAILURE() << "accepted: " << json;
-        } catch (const ParamError& error) {
-            EXPECT_NE(std::string(error.what()).find(message), std::string::npos) << error.what();
-        }
-    }
-}
-
-/// The C ABI's bake and mesh calls, as the Blender add-on uses them.
-class BakeCApi : public Bake {
-protected:
-    void SetUp() override {
-        Bake::SetUp();
-        ASSERT_EQ(dqj_context_create(&context_), DQJ_OK);
-    }
-    void TearDown() override {
-        dqj_context_destroy(context_);
-        Bake::TearDown();
-    }
-    dqj_context context_ = nullptr;
-};
-
-TEST_F(BakeCApi, MeshIntoCallerBuffers) {
-    ASSERT_EQ(dqj_context_set_params_json(context_, R"({"fractal": {"c": [0,0,0,0,0,0,0,0]},
-        "bake": {"bounds": {"min": [-1.5,-1.5,-1.5], "max": [1.5,1.5,1.5]}}})"),
-              DQJ_OK);
-    ASSERT_EQ(dqj_context_set_bake_resolution(context_, 24), DQJ_OK);
-    EXPECT_EQ(dqj_context_set_bake_resolution(context_, 3), DQJ_ERROR_PARAMETERS);
-    EXPECT_NE(std::string(dqj_context_error(context_)).find("bake.resolution"), std::string::npos);
-    size_t vertices = 99, triangles = 99;
-    ASSERT_EQ(dqj_mesh_get_sizes(context_, &vertices, &triangles), DQJ_OK);
-    EXPECT_EQ(vertices, 0u);
-    EXPECT_EQ(triangles, 0u);
-    ASSERT_EQ(dqj_mesh_compute(context_, nullptr, nullptr), DQJ_OK) << dqj_context_error(context_);
-    ASSERT_EQ(dqj_mesh_get_sizes(context_, &vertices, &triangles), DQJ_OK);
-    ASSERT_GT(vertices, 100u);
-    std::vector<float> positions(3 * vertices), normals(3 * vertices), colors(3 * vertices);
-    std::vector<uint32_t> indices(3 * triangles);
-    EXPECT_EQ(dqj_mesh_copy(context_, positions.data(), nullptr, nullptr, vertices - 1, indices.data(), triangles),
-              DQJ_ERROR_INVALID_ARGUMENT);
-    EXPECT_NE(std::string(dqj_context_error(context_)).find("too small"), std::string::npos);
-    ASSERT_EQ(dqj_mesh_copy(context_, positions.data(), normals.data(), colors.data(), vertices, indices.data(),
-                            triangles),
-              DQJ_OK);
-    dqj_bake_stats stats = DQJ_BAKE_STATS_INIT;
-    ASSERT_EQ(dqj_bake_get_stats(context_, &stats), DQJ_OK);
-    for (size_t index = 0; index < vertices; ++index) {
-        const glm::vec3 p(positions[3 * index], positions[3 * index + 1], positions[3 * index + 2]);
-        EXPECT_NEAR(glm::length(p), 1.0, 3.0 / 24);
-        EXPECT_GE(colors[3 * index], 0.0f);
-    }
-    std::map<std::pair<uint32_t, uint32_t>, int> uses;
-    for (size_t index = 0; index < indices.size(); index += 3)
-        for (int corner = 0; corner < 3; ++corner) {
-            const uint32_t a = indices[index + corner], b = indices[index + (corner + 1) % 3];
-            ASSERT_LT(a, vertices);
-            ++uses[{std::min(a, b), std::max(a, b)}];
-        }
-    for (const auto& [edge, count] : uses) ASSERT_EQ(count, 2);
-    EXPECT_GT(stats.voxels_evaluated, 0u);
-    EXPECT_EQ(stats.voxels_dense, 24u * 24u * 24u);
-    // The faces as the core made them: every quad and triangle, and the triangulated copy
-    // above is the same faces split.
-    size_t quads = 0, faceTriangles = 0;
-    ASSERT_EQ(dqj_mesh_get_face_counts(context_, &quads, &faceTriangles), DQJ_OK);
-    EXPECT_EQ(2 * quads + faceTriangles, triangles);
-    EXPECT_GT(quads, faceTriangles);
-    std::vector<uint32_t> quadIndices(4 * quads), triangleIndices(3 * faceTriangles + 3);
-    EXPECT_EQ(dqj_mesh_copy_faces(context_, quadIndices.data(), quads - 1, triangleIndices.data(), faceTriangles),
-              DQJ_ERROR_INVALID_ARGUMENT);
-    EXPECT_EQ(dqj_mesh_copy_faces(context_, nullptr, 0, triangleIndices.data(), faceTriangles),
-              quads ? DQJ_ERROR_INVALID_ARGUMENT : DQJ_OK);
-    ASSERT_EQ(dqj_mesh_copy_faces(context_, quadIndices.data(), quads, triangleIndices.data(), faceTriangles), DQJ_OK);
-    EXPECT_TRUE(std::equal(triangleIndices.begin(), triangleIndices.begin() + 3 * faceTriangles, indices.begin()));
-    for (size_t face = 0; face < quads; ++face) {  // after the triangles, split along the 0-2 diagonal
-        const uint32_t* q = &quadIndices[4 * face];
-        const std::vector<uint32_t> split{q[0], q[1], q[2], q[0], q[2], q[3]};
-        const auto first = indices.begin() + 3 * faceTriangles + 6 * face;
-        const std::vector<uint32_t> copied(first, first + 6);
-        ASSERT_EQ(copied, split) << "quad " << face;
-    }
-    std::vector<float> vertexOnly(3 * vertices);
-    ASSERT_EQ(dqj_mesh_copy(context_, vertexOnly.data(), nullptr, nullptr, vertices, nullptr, 0), DQJ_OK);
-    EXPECT_EQ(vertexOnly, positions);
-    ASSERT_EQ(dqj_mesh_write(context_, path("c.ply").c_str()), DQJ_OK);
-    EXPECT_TRUE(fs::exists(path("c.ply")));
-    EXPECT_EQ(dqj_mesh_write(context_, path("c.stl").c_str()), DQJ_ERROR_PARAMETERS);
-    EXPECT_EQ(dqj_mesh_copy(nullptr, positions.data(), nullptr, nullptr, vertices, indices.data(), triangles),
-              DQJ_ERROR_INVALID_HANDLE);
-}
-
-int cancelAfterStart(double fraction, void* calls) {
-    ++*static_cast<int*>(calls);
-    return fraction == 0.0;  // 0: cancel once the work is under way
-}
-
-TEST_F(BakeCApi, BakeWithCancelMemoryLimitAndFrames) {
-    ASSERT_EQ(dqj_context_set_bake_resolution(context_, 32), DQJ_OK);
-    const std::string target = path("b.vdb");
-    ASSERT_EQ(dqj_bake_vdb(context_, target.c_str(), nullptr, nullptr), DQJ_OK) << dqj_context_error(context_);
-    EXPECT_EQ(readGrids(target).count("density"), 1u);
-    const auto size = fs::file_size(target);
-
-    ASSERT_EQ(dqj_context_set_bake_resolution(context_, 64), DQJ_OK);
-    int calls = 0;
-    EXPECT_EQ(dqj_bake_vdb(context_, target.c_str(), cancelAfterStart, &calls), DQJ_ERROR_CANCELLED);
-    EXPECT_EQ(fs::file_size(target), size);  // the old file is untouched
-    EXPECT_EQ(files(), std::vector<std::string>{"b.vdb"});
-
-    ASSERT_EQ(dqj_context_set_memory_limit(context_, 1000), DQJ_OK);
-    EXPECT_EQ(dqj_bake_vdb(context_, path("c.vdb").c_str(), nullptr, nullptr), DQJ_ERROR_OUT_OF_MEMORY);
-    EXPECT_NE(std::string(dqj_context_error(context_)).find("--max-memory"), std::string::npos);
-    EXPECT_FALSE(fs::exists(path("c.vdb")));
-    ASSERT_EQ(dqj_context_set_memory_limit(context_, 0), DQJ_OK);
-
-    // Keyframed iterations: frame 1 and frame 3 bake different surfaces.
-    ASSERT_EQ(dqj_context_set_params_json(context_, R"({"bake": {"resolution": 32},
-        "animation": {"fractal.iterations": [{"frame": 1, "value": 4}, {"frame": 3, "value": 15}]}})"),
-              DQJ_OK);
-    dqj_bake_stats first = DQJ_BAKE_STATS_INIT, third = DQJ_BAKE_STATS_INIT;
-    ASSERT_EQ(dqj_context_set_frame(context_, 1), DQJ_OK);
-    ASSERT_EQ(dqj_bake_vdb(context_, path("f1.vdb").c_str(), nullptr, nullptr), DQJ_OK);
-    ASSERT_EQ(dqj_bake_get_stats(context_, &first), DQJ_OK);
-    ASSERT_EQ(dqj_context_set_frame(context_, 3), DQJ_OK);
-    ASSERT_EQ(dqj_bake_vdb(context_, path("f3.vdb").c_str(), nullptr, nullptr), DQJ_OK);
-    ASSERT_EQ(dqj_bake_get_stats(context_, &third), DQJ_OK);
-    EXPECT_NE(first.active_voxels, third.active_voxels);
-    EXPECT_EQ(dqj_context_set_frame(context_, NAN), DQJ_ERROR_INVALID_ARGUMENT);
-    EXPECT_EQ(dqj_bake_vdb(context_, nullptr, nullptr, nullptr), DQJ_ERROR_INVALID_ARGUMENT);
-    EXPECT_EQ(dqj_bake_vdb(context_, path("x.png").c_str(), nullptr, nullptr), DQJ_ERROR_PARAMETERS);
-    EXPECT_EQ(dqj_bake_vdb(context_, path("no/such/folder/x.vdb").c_str(), nullptr, nullptr), DQJ_ERROR_IO);
-    EXPECT_NE(std::string(dqj_context_error(context_)).find("no/such/folder"), std::string::npos);
 }
 
 }  // namespace

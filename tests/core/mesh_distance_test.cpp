@@ -16,9 +16,9 @@
 #include <openvdb/tools/VolumeToMesh.h>
 
 #include "dqjulia/params.hpp"
-#include "mesh_distance.hpp"
-#include "sparse_sampler.hpp"
-#include "staged_progress.hpp"
+#include "bake/mesh_distance.hpp"
+#include "bake/sparse_sampler.hpp"
+#include "bake/staged_progress.hpp"
 
 using namespace dqj;
 

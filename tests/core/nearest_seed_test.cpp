@@ -1,4 +1,4 @@
-// nearestSeeds (core/src/nearest_seed.hpp, internal): against the brute-force nearest seed, on a
+// nearestSeeds (core/src/bake/nearest_seed.hpp, internal): against the brute-force nearest seed, on a
 // box (convex: every seed's nearest voxels are reachable) and on two pieces, one without seeds;
 // with its rounds bounded, a voxel's seed depends on nothing further than that many steps.
 #include <gtest/gtest.h>
@@ -11,7 +11,7 @@
 
 #include <openvdb/openvdb.h>
 
-#include "nearest_seed.hpp"
+#include "bake/nearest_seed.hpp"
 
 namespace {
 

@@ -285,5 +285,31 @@ TEST(Keyframes, ValuesBetweenKeysNeverLeaveTheKeys) {
     }
 }
 
+TEST(BakeParams, TheBakeSectionRoundTripsAndIsChecked) {
+    const Params params = parseParams(R"({"bake": {"resolution": 96, "bounds": {"min": [-1, -1, -1], "max": [1, 2, 1]},
+        "band_width": 2, "grids": ["density", "color"], "adaptivity": 0.25, "mesh_colors": false}})");
+    EXPECT_EQ(params.bake.resolution, 96);
+    EXPECT_EQ(params.bake.bounds->max.y, 2.0);
+    EXPECT_EQ(params.bake.grids, (std::vector<BakeGrid>{BakeGrid::Density, BakeGrid::Color}));
+    EXPECT_FALSE(params.bake.meshColors);
+    EXPECT_EQ(toJson(parseParams(toJson(params))), toJson(params));
+    const std::vector<std::pair<std::string, std::string>> bad = {
+        {R"({"bake": {"resolution": 4}})", "bake.resolution"},
+        {R"({"bake": {"grids": ["surface", "surface"]}})", "twice"},
+        {R"({"bake": {"grids": ["fog"]}})", "surface, density, color, trap, iterations"},
+        {R"({"bake": {"bounds": {"min": [1, 0, 0], "max": [0, 1, 1]}}})", "min must be below max"},
+        {R"({"bake": {"adaptivity": 2}})", "bake.adaptivity"},
+        {R"({"bake": {"resolutoin": 64}})", "did you mean \"resolution\""},
+    };
+    for (const auto& [json, message] : bad) {
+        try {
+            parseParams(json);
+            ADD_FAILURE() << "accepted: " << json;
+        } catch (const ParamError& error) {
+            EXPECT_NE(std::string(error.what()).find(message), std::string::npos) << error.what();
+        }
+    }
+}
+
 }  // namespace
 }  // namespace dqj

@@ -12,7 +12,7 @@
 #include <glm/geometric.hpp>
 
 #include "dqjulia/params.hpp"
-#include "sparse_sampler.hpp"
+#include "bake/sparse_sampler.hpp"
 
 using namespace dqj;
 

@@ -1,5 +1,5 @@
 // tile_merge_check.hpp - what the tiled-bake tests share (tiles_test.cpp, tiles_long_test.cpp):
-// a scratch folder, baking every tile of a tiling, the merged file compared with the one-piece
+// the bake fixture (bake_fixture.hpp), baking every tile of a tiling, the merged file compared with the one-piece
 // bake's voxel for voxel, every grid (values bit for bit and active states, over the bounding
 // box of both grids' active voxels grown by 2, so the inside and outside beyond the band too),
 // and crops of large bakes at their voxel size.
@@ -23,21 +23,16 @@
 #include "dqjulia/bake.hpp"
 #include "dqjulia/params.hpp"
 #include "dqjulia/tiles.hpp"
-#include "sparse_sampler.hpp"  // bakeIndexBox, bakeVoxelSize (internal)
-#include "test_support.hpp"
-#include "tile_geometry.hpp"  // tileWindow (internal)
+#include "bake/sparse_sampler.hpp"  // bakeIndexBox, bakeVoxelSize (internal)
+#include "bake/tile_geometry.hpp"   // tileWindow (internal)
+#include "bake_fixture.hpp"
 
 namespace dqj::test {
 
 namespace fs = std::filesystem;
 
-class Tiles : public ::testing::Test {
+class Tiles : public BakeFolder {
 public:
-    static void SetUpTestSuite() { openvdb::initialize(); }
-    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_tiles"); }
-    void TearDown() override { fs::remove_all(dir_); }
-    std::string path(const std::string& name) const { return (dir_ / name).string(); }
-
     /// Bakes every tile of `tiling` beside "whole.vdb" and returns their paths.
     std::vector<std::string> bakeTiles(const Params& params, const std::string& tiling) {
         Tile tile = parseTiling(tiling);
@@ -50,24 +45,7 @@ public:
         }
         return paths;
     }
-    fs::path dir_;
 };
-
-struct VdbFile {
-    std::map<std::string, openvdb::GridBase::Ptr> grids;
-    openvdb::MetaMap::Ptr metadata;
-};
-
-inline VdbFile readVdb(const std::string& path) {
-    openvdb::io::File file(path);
-    file.open();
-    VdbFile result;
-    const openvdb::GridPtrVecPtr grids = file.getGrids();
-    for (const openvdb::GridBase::Ptr& grid : *grids) result.grids[grid->getName()] = grid;
-    result.metadata = file.getMetadata();
-    file.close();
-    return result;
-}
 
 /// Voxels compared and those that differ (value bits or active state) between two grids of
 /// one type, over the bounding box of both grids' active voxels grown by 2 voxels.

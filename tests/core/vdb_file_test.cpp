@@ -12,26 +12,20 @@
 
 #include <openvdb/openvdb.h>
 
-#include "atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "dqjulia/bake.hpp"
 #include "dqjulia/params.hpp"
 #include "dqjulia/tiles.hpp"
 #include "test_support.hpp"
-#include "vdb_file.hpp"
+#include "files/vdb_file.hpp"
+#include "bake_fixture.hpp"
 
 namespace fs = std::filesystem;
 using namespace dqj;
 
 namespace {
 
-class VdbFiles : public ::testing::Test {
-protected:
-    static void SetUpTestSuite() { openvdb::initialize(); }
-    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_vdb_file"); }
-    void TearDown() override { fs::remove_all(dir_); }
-    std::string path(const std::string& name) const { return (dir_ / name).string(); }
-    fs::path dir_;
-};
+using VdbFiles = dqj::test::BakeFolder;
 
 /// A small bake of the default fractal with a level set, a fog volume and a colour grid (the
 /// colour grid is the one class OpenVDB compresses with zlib too).

@@ -31,12 +31,11 @@ namespace {
 
 #define EXPECT_CONTAINS(text, part) EXPECT_NE(std::string(text).find(part), std::string::npos) << "in: " << (text)
 
-class Hostile : public ::testing::Test {
+class Hostile : public dqj::test::ScratchFolder {
 protected:
-    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_hostile"); }
     void TearDown() override {
         disk_.reset();
-        fs::remove_all(dir_);
+        ScratchFolder::TearDown();
     }
     dqj::test::CommandResult run(const std::string& arguments, const std::string& input = "") {
         return dqj::test::runCommand(DQJ_CLI, arguments, dir_, input);
@@ -70,7 +69,6 @@ protected:
         return disk_->mounted();
     }
 
-    fs::path dir_;
     fs::path mount_;
     std::optional<dqj::test::Tmpfs> disk_;
 };

@@ -58,10 +58,8 @@ std::vector<TextOption> textOptions(const std::string& help) {
     return options;
 }
 
-class Messages : public ::testing::Test {
+class Messages : public dqj::test::ScratchFolder {
 protected:
-    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_messages"); }
-    void TearDown() override { fs::remove_all(dir_); }
     dqj::test::CommandResult run(const std::vector<std::string>& arguments) {
         std::string line;
         for (const std::string& argument : arguments) {
@@ -71,7 +69,6 @@ protected:
         }
         return dqj::test::runCommand(DQJ_CLI, line, dir_);
     }
-    fs::path dir_;
 };
 
 TEST_F(Messages, EveryTextFlagOfEveryCommandIsEscapedInEveryMessage) {

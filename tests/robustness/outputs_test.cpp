@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "atomic_file.hpp"
+#include "files/atomic_file.hpp"
 #include "test_support.hpp"
 
 namespace fs = std::filesystem;
@@ -41,12 +41,11 @@ std::map<std::string, std::string> snapshot(const fs::path& folder) {
     return files;
 }
 
-class Outputs : public ::testing::Test {
+class Outputs : public dqj::test::ScratchFolder {
 protected:
-    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_outputs"); }
     void TearDown() override {
         disk_.reset();
-        fs::remove_all(dir_);
+        ScratchFolder::TearDown();
     }
     /// `arguments` with DIR replaced by the scratch folder, run in it.
     dqj::test::CommandResult run(std::string arguments, const std::string& input = "") {
@@ -56,7 +55,6 @@ protected:
     }
     void write(const fs::path& path, const std::string& text) const { std::ofstream(path, std::ios::binary) << text; }
 
-    fs::path dir_;
     std::optional<dqj::test::Tmpfs> disk_;  // unmounted before the folder is removed
 };
 

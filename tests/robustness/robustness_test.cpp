@@ -26,13 +26,9 @@ using dqj::test::readFile;
 namespace {
 
 /// A scratch folder per test.
-class Scratch : public ::testing::Test {
+class Scratch : public dqj::test::ScratchFolder {
 protected:
-    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_robust"); }
-    void TearDown() override { fs::remove_all(dir_); }
     std::vector<std::string> filesIn(const fs::path& folder) const { return dqj::test::fileNames(folder); }
-
-    fs::path dir_;
 };
 
 int waitExit(pid_t pid) {

@@ -1,5 +1,5 @@
 // dqjulia_de.glsl - the escape iteration, distance estimate and sphere tracer of the core
-// (math.md; core/src/estimate.cpp and core/src/render.cpp), in single precision GLSL.
+// (math.md; core/src/kernel/estimate.cpp and core/src/render/render.cpp), in single precision GLSL.
 //
 // The one place besides the core where the maths is written again, so it is written to be
 // compiled three ways and kept equal to the core by tests:

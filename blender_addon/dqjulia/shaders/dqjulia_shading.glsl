@@ -1,5 +1,5 @@
 // dqjulia_shading.glsl - the core's colouring and shading (core/include/dqjulia/coloring.hpp
-// and core/src/coloring.cpp), in single precision GLSL: the smooth escape count, the trap's
+// and core/src/kernel/coloring.cpp), in single precision GLSL: the smooth escape count, the trap's
 // scale, the palette, the orbit colour of each colouring and the Phong terms. Same names as
 // the core's functions, dqj_ and snake case (orbitColour is dqj_orbit_colour).
 //

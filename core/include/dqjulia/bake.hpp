@@ -1,5 +1,7 @@
 // dqjulia/bake.hpp - bakes the fractal into an OpenVDB file: a narrow-band level set "surface",
 // a fog volume "density" and optional attribute grids ("color", "trap", "iterations").
+// Code: core/src/bake/bake.cpp; the memory limits (MemoryLimitError, processMemoryHeadroom,
+// defaultMemoryLimit, formatBytes) in core/src/bake/memory.cpp.
 //
 // The surface (README "Baking"): with h the voxel size and eps = h / 4, the solid is the
 // N-iteration set together with every point whose 3-D distance estimate is below eps, cut to

@@ -1,4 +1,5 @@
-/* dqjulia/dqjulia.h - the C ABI of libdqjulia: dual-quaternion Julia fractals.
+/* dqjulia/dqjulia.h - the C ABI of libdqjulia: dual-quaternion Julia fractals (implemented in
+ * core/src/c_api.cpp).
  *
  * The one stable surface of the library, for C programs and for hosts that load it
  * at run time (the Blender add-on uses it through ctypes).

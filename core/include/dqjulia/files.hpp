@@ -1,4 +1,5 @@
 // dqjulia/files.hpp - how the toolkit's writers treat the files they write.
+// Code: core/src/files/atomic_file.cpp (checkWritable).
 #pragma once
 
 #include <string>

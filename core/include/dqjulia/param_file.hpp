@@ -1,4 +1,6 @@
 // dqjulia/param_file.hpp - the parameter file: JSON in, validated Params out, and back.
+// Code: core/src/params/param_read.cpp (ParamError, parseParams, loadParams), param_validate.cpp
+// (validate) and param_write.cpp (toJson, saveParams).
 //
 // One format for the CLI, the Blender add-on and the POV-Ray writer, described key by key by
 // the schema (schema.hpp, README "Parameter file"). Loading validates every value and throws

@@ -1,6 +1,7 @@
 // dqjulia/param_types.hpp - the parameter set shared by the whole toolkit: what the parameter
 // file holds, as C++ values with their defaults. The defaults here are the only ones: the
 // schema (schema.hpp), the file's writer and the Blender add-on take them from these structs.
+// Code: core/src/params/param_types.cpp.
 #pragma once
 
 #include <optional>

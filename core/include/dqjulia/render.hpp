@@ -1,4 +1,5 @@
 // dqjulia/render.hpp - the sphere-tracing renderer.
+// Code: core/src/render/render.cpp (render) and camera.cpp (frameCamera, rayDirection).
 //
 // Rays start where they enter the bounding sphere (radius r_K, math.md) and step by
 // stepFactor * min(DE / stretch, maxStep) until the DE falls below the pixel footprint

@@ -1,5 +1,6 @@
 // dqjulia/schema.hpp - every key of the parameter file described once: its type, range, label
 // and help text; its default is the one of the structs in param_types.hpp.
+// Code: core/src/params/schema.cpp.
 //
 // The reader checks each value against its field here, validate() checks a Params against the
 // same fields, and schemaJson() publishes them (with the defaults) for front ends that build

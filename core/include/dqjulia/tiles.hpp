@@ -1,6 +1,8 @@
 // dqjulia/tiles.hpp - tiled bakes for farms: one bake cut into boxes that are baked apart (by
 // other processes or machines) and merged into the file the one-piece bake writes, voxel for
 // voxel.
+// Code: core/src/bake/tile_geometry.cpp (the tiling, tilePath, tileHalo, checkTile: a tile's bake
+// needs them) and core/src/tiles/tiles.cpp (mergeTiles).
 //
 // A tile (BakeOptions::tile) bakes on the whole bake's voxel grid (the same voxel size and
 // index space, cut only where the whole is cut, at its bounds): it samples the box it owns

@@ -1,0 +1,30 @@
+// memory.hpp - the memory a bake, a mesh or a merge is estimated to take and may take (internal
+// to libdqjulia; code in memory.cpp, which also holds bake.hpp's MemoryLimitError,
+// processMemoryHeadroom, defaultMemoryLimit and formatBytes). Cost: the estimates are a few
+// operations; the limits read a few small files of /proc and /sys (Linux) or ask the job object
+// (Windows).
+#pragma once
+
+#include <cstdint>
+
+#include "dqjulia/bake.hpp"
+
+namespace dqj {
+
+/// Bytes the caller's later stages need per sampled leaf, for the memory estimate.
+struct MemoryModel {
+    double bytesPerLeaf = 0.0;
+    double fixedBytes = 0.0;
+};
+
+/// What a bake takes beyond its sampled leaves, by the grids it writes (bakeVdb).
+MemoryModel bakeMemoryModel(const BakeSettings& bake);
+
+/// What a mesh takes beyond its sampled leaves (bakeMesh).
+MemoryModel meshMemoryModel();
+
+/// The process's peak resident memory, in bytes (0 where the system does not say): what the
+/// command's --stats prints.
+std::uint64_t peakMemoryBytes();
+
+}  // namespace dqj
