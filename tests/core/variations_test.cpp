@@ -1,0 +1,222 @@
+// Variations (variations.hpp): determinism, validity, locks, strength, diversity, bad input.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <cstring>
+
+#include "dqjulia/inspect.hpp"
+#include "dqjulia/params.hpp"
+#include "dqjulia/variations.hpp"
+
+namespace {
+
+using dqj::Params;
+using dqj::VariationOptions;
+
+VariationOptions options(std::uint64_t seed, double strength, unsigned locked = dqj::kGroupVariant, int count = 9) {
+    VariationOptions o;
+    o.seed = seed;
+    o.strength = strength;
+    o.locked = locked;
+    o.count = count;
+    return o;
+}
+
+double meanDistance(const dqj::VariationResult& result) {
+    double sum = 0.0;
+    for (const dqj::Variation& variation : result.variations) sum += variation.measures.distance;
+    return sum / double(result.variations.size());
+}
+
+TEST(Variations, SameSeedGivesTheSameDocumentsByteForByte) {
+    const Params base;
+    const dqj::VariationResult first = dqj::vary(base, options(7, 0.3));
+    const dqj::VariationResult second = dqj::vary(base, options(7, 0.3));
+    ASSERT_EQ(first.variations.size(), 9u);
+    ASSERT_EQ(second.variations.size(), 9u);
+    for (std::size_t i = 0; i < 9; ++i)
+        EXPECT_EQ(dqj::toJson(first.variations[i].params), dqj::toJson(second.variations[i].params)) << i;
+    const dqj::VariationResult other = dqj::vary(base, options(8, 0.3));
+    EXPECT_NE(dqj::toJson(first.variations[0].params), dqj::toJson(other.variations[0].params));
+}
+
+TEST(Variations, EveryVariationIsValidNonEmptyAndWithinTheMeasures) {
+    for (const double strength : {0.05, 0.3, 1.0}) {
+        const dqj::VariationResult result = dqj::vary(Params(), options(3, strength, 0));
+        ASSERT_EQ(result.variations.size(), 9u);
+        for (const dqj::Variation& variation : result.variations) {
+            const std::string json = dqj::toJson(variation.params);
+            const Params again = dqj::parseParams(json, "variation");  // complete and valid
+            EXPECT_EQ(dqj::toJson(again), json);
+            const dqj::InspectReport report = dqj::inspect(again, 16);
+            EXPECT_TRUE(report.emptyReason.empty()) << report.emptyReason;
+            EXPECT_TRUE(report.real.inMandelbrot);
+            if (again.fractal.variant != dqj::Variant::Dual) EXPECT_TRUE(report.dual.inMandelbrot);
+            EXPECT_GE(variation.measures.coverage, dqj::kMinCoverage);
+            EXPECT_GE(variation.measures.roughness, dqj::kMinRoughness);
+            EXPECT_GE(variation.measures.distance, result.minimumDistance);
+            EXPECT_NE(variation.params.description.find("Variation "), std::string::npos);
+        }
+    }
+}
+
+TEST(Variations, LockedGroupsStayBitForBit) {
+    Params base;
+    base.slice.rotations = {dqj::PlaneRotation{2, 4, 12.5}};
+    base.slice.base.origin[6] = 0.125;
+    for (const unsigned locked : {dqj::kGroupA | dqj::kGroupVariant, dqj::kGroupB | dqj::kGroupIterations | dqj::kGroupVariant,
+                                  dqj::kGroupSliceOrientation | dqj::kGroupSliceOrigin | dqj::kGroupVariant,
+                                  dqj::kAllVariationGroups & ~dqj::kGroupA}) {
+        const dqj::VariationResult result = dqj::vary(base, options(5, 0.6, locked, 6));
+        ASSERT_EQ(result.variations.size(), 6u);
+        for (const dqj::Variation& variation : result.variations) {
+            const Params& p = variation.params;
+            auto same = [](const auto& x, const auto& y) { return std::memcmp(&x, &y, sizeof x) == 0; };
+            if (locked & dqj::kGroupA) EXPECT_TRUE(same(p.fractal.c.a, base.fractal.c.a));
+            if (locked & dqj::kGroupB) EXPECT_TRUE(same(p.fractal.c.b, base.fractal.c.b));
+            if (locked & dqj::kGroupIterations) {
+                EXPECT_EQ(p.fractal.iterations, base.fractal.iterations);
+                EXPECT_TRUE(same(p.fractal.bailout, base.fractal.bailout));
+            }
+            if (locked & dqj::kGroupSliceOrientation) {
+                ASSERT_EQ(p.slice.rotations.size(), base.slice.rotations.size());
+                for (std::size_t i = 0; i < p.slice.rotations.size(); ++i) {
+                    EXPECT_EQ(p.slice.rotations[i].first, base.slice.rotations[i].first);
+                    EXPECT_EQ(p.slice.rotations[i].second, base.slice.rotations[i].second);
+                    EXPECT_TRUE(same(p.slice.rotations[i].degrees, base.slice.rotations[i].degrees));
+                }
+                EXPECT_TRUE(same(p.slice.base.axes, base.slice.base.axes));
+            }
+            if (locked & dqj::kGroupSliceOrigin) EXPECT_TRUE(same(p.slice.base.origin, base.slice.base.origin));
+            if (locked & dqj::kGroupVariant) EXPECT_EQ(p.fractal.variant, base.fractal.variant);
+            // What no group covers is never touched.
+            EXPECT_EQ(p.render.width, base.render.width);
+            Params rest = p;
+            rest.description = base.description;
+            rest.fractal = base.fractal;
+            rest.slice = base.slice;
+            EXPECT_EQ(dqj::toJson(rest), dqj::toJson(base));
+        }
+    }
+}
+
+TEST(Variations, StrengthRaisesTheMeanDistanceFromTheOriginal) {
+    // Averaged over three seeds: tiny < small < medium < large < huge.
+    double previous = 0.0;
+    for (const dqj::StrengthName& name : dqj::strengthNames()) {
+        double sum = 0.0;
+        for (const std::uint64_t seed : {1u, 2u, 3u}) sum += meanDistance(dqj::vary(Params(), options(seed, name.value)));
+        const double mean = sum / 3.0;
+        EXPECT_GT(mean, previous) << name.name;
+        previous = mean;
+    }
+}
+
+TEST(Variations, NoTwoThumbnailsNearlyTheSame) {
+    for (const double strength : {0.05, 0.6}) {
+        const dqj::VariationResult result = dqj::vary(Params(), options(11, strength));
+        std::vector<std::vector<std::uint16_t>> thumbnails;
+        for (const dqj::Variation& variation : result.variations) thumbnails.push_back(dqj::thumbnailOf(variation.params));
+        const auto original = dqj::thumbnailOf(Params());
+        for (std::size_t i = 0; i < thumbnails.size(); ++i) {
+            EXPECT_GE(dqj::thumbnailDistance(thumbnails[i], original), dqj::minimumDistance(strength));
+            for (std::size_t j = 0; j < i; ++j)
+                EXPECT_GE(dqj::thumbnailDistance(thumbnails[i], thumbnails[j]), dqj::minimumDistance(strength)) << i << j;
+        }
+    }
+}
+
+TEST(Variations, ThumbnailDistanceIsAJaccardDistance) {
+    const std::vector<std::uint16_t> a{0, 10, 10, 0}, b{0, 10, 0, 10};
+    EXPECT_EQ(dqj::thumbnailDistance(a, a), 0.0);
+    EXPECT_DOUBLE_EQ(dqj::thumbnailDistance(a, b), 1.0 - 10.0 / 30.0);
+    EXPECT_EQ(dqj::thumbnailDistance({0, 0}, {5, 0}), 1.0);
+}
+
+TEST(Variations, NamesOfStrengthsAndGroups) {
+    EXPECT_EQ(dqj::parseStrength("tiny"), 0.05);
+    EXPECT_EQ(dqj::parseStrength("huge"), 1.0);
+    EXPECT_EQ(dqj::parseStrength("0.4"), 0.4);
+    EXPECT_FALSE(dqj::parseStrength("enormous"));
+    EXPECT_FALSE(dqj::parseStrength(""));
+    EXPECT_EQ(dqj::parseGroups("a,slice"), dqj::kGroupA | dqj::kGroupSliceOrientation | dqj::kGroupSliceOrigin);
+    EXPECT_EQ(dqj::parseGroups("none"), 0u);
+    std::string unknown;
+    EXPECT_FALSE(dqj::parseGroups("a,colour", &unknown));
+    EXPECT_EQ(unknown, "colour");
+    EXPECT_EQ(dqj::groupNames(dqj::kGroupB | dqj::kGroupIterations), "b, iterations");
+}
+
+/// The ParamError's message of vary(base, o), or "" if it passed.
+std::string failure(const Params& base, const VariationOptions& o) {
+    try {
+        dqj::vary(base, o);
+    } catch (const dqj::ParamError& error) {
+        return error.what();
+    }
+    return "";
+}
+
+TEST(Variations, BadInputGetsAClearMessage) {
+    const Params base;
+    EXPECT_NE(failure(base, options(1, 1.5)).find("strength 1.5 is out of range"), std::string::npos);
+    EXPECT_NE(failure(base, options(1, 0.0)).find("out of range"), std::string::npos);
+    EXPECT_NE(failure(base, options(1, std::nan(""))).find("out of range"), std::string::npos);
+    EXPECT_NE(failure(base, options(1, 0.3, dqj::kAllVariationGroups)).find("every group is locked"), std::string::npos);
+    EXPECT_NE(failure(base, options(1, 0.3, 0, 0)).find("count 0"), std::string::npos);
+    // A starting document that is itself empty: the dual part's own orbit escapes.
+    Params empty;
+    empty.fractal.c.b = dqj::makeQuat(0.6, 0.6, 0, 0);
+    EXPECT_NE(failure(empty, options(1, 0.3)).find("starting document is itself empty"), std::string::npos);
+    // Dust in a locked part.
+    Params dust;
+    dust.fractal.c.a = dqj::makeQuat(0.3, 0.6, 0, 0);  // 0.3 + 0.6i lies outside the Mandelbrot set
+    dust.slice.rotations.clear();
+    const std::string message = failure(dust, options(1, 0.3, dqj::kGroupA | dqj::kGroupVariant));
+    EXPECT_NE(message.find("dust"), std::string::npos) << message;
+}
+
+TEST(Variations, BoundedTriesSayHowToLoosenTheSettings) {
+    // Only the iterations may change, at a tiny strength: N moves by at most one or two, too
+    // little for nine different thumbnails. The search stops at its bound and says why.
+    VariationOptions o = options(1, 0.05, dqj::kAllVariationGroups & ~dqj::kGroupIterations);
+    o.maxCandidates = 40;
+    const std::string message = failure(Params(), o);
+    EXPECT_NE(message.find("found only"), std::string::npos) << message;
+    EXPECT_NE(message.find("in 40 candidates"), std::string::npos) << message;
+    EXPECT_NE(message.find("raise the strength"), std::string::npos) << message;
+    EXPECT_NE(message.find("unlock groups"), std::string::npos) << message;
+}
+
+TEST(Variations, ProgressCanCancel) {
+    EXPECT_THROW(dqj::vary(Params(), options(1, 0.3), [](double fraction) { return fraction < 0.01; }),
+                 dqj::Cancelled);
+}
+
+TEST(Variations, Figures) {
+    if (!std::getenv("DQJ_VARIATION_FIGURES")) GTEST_SKIP();
+    for (const dqj::StrengthName& name : dqj::strengthNames()) {
+        VariationOptions o = options(1, name.value, dqj::kGroupVariant, 100);
+        o.maxCandidates = 1000;
+        dqj::VariationResult result;
+        try {
+            result = dqj::vary(Params(), o);
+        } catch (const dqj::ParamError& e) {
+            std::printf("%s\n", e.what());
+            continue;
+        }
+        double lo = 1, hi = 0, sum = 0;
+        for (auto& v : result.variations) {
+            lo = std::min(lo, v.measures.distance);
+            hi = std::max(hi, v.measures.distance);
+            sum += v.measures.distance;
+        }
+        std::printf("%s: %d candidates, accepted %zu, rejected", std::string(name.name).c_str(), result.candidates,
+                    result.variations.size());
+        for (int r = 0; r < dqj::kRejectionCount; ++r)
+            std::printf(" %s %d", std::string(dqj::rejectionName(dqj::Rejection(r))).c_str(), result.rejected[r]);
+        std::printf("; distance min %.3f mean %.3f max %.3f\n", lo, sum / result.variations.size(), hi);
+    }
+}
+
+}  // namespace
