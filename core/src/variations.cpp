@@ -311,7 +311,8 @@ std::string describe(const std::string& original, const VariationOptions& option
     if (rest.rfind("Variation ", 0) == 0)
         if (const auto of = rest.find(" of: "); of != std::string::npos) rest = rest.substr(of + 5);
     return "Variation " + std::to_string(number) + " (seed " + std::to_string(options.seed) + ", strength " +
-           strengthText(options.strength) + ", locked: " + groupNames(options.locked) + ") of: " + rest;
+           strengthText(options.strength) + ", locked: " + groupNames(options.locked) + ")" +
+           (rest.empty() ? std::string() : " of: " + rest);
 }
 
 }  // namespace
