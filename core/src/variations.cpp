@@ -315,6 +315,48 @@ std::string describe(const std::string& original, const VariationOptions& option
            (rest.empty() ? std::string() : " of: " + rest);
 }
 
+/// Judges candidates 0, 1, ... in order until `wanted` pass or `limit` were judged.
+VariationResult search(const Params& base, const std::vector<std::uint16_t>& original, const VariationOptions& options,
+                       int limit, int wanted, const ProgressCallback& progress) {
+    VariationResult result;
+    result.minimumDistance = minimumDistance(options.strength);
+    const Slice baseSlice = base.slice.effective();
+    std::vector<std::vector<std::uint16_t>> accepted;
+    if (progress && !progress(0.0)) throw Cancelled();
+    constexpr int kBlock = 8;  // candidates measured in parallel, then judged in their order
+    for (int next = 0; int(result.variations.size()) < wanted && next < limit; next += kBlock) {
+        const int size = std::min(kBlock, limit - next);
+        std::vector<Judged> judged(size);
+        tbb::parallel_for(0, size, [&](int i) { judged[i] = judge(candidateFor(base, baseSlice, options, next + i)); });
+        for (int i = 0; i < size && int(result.variations.size()) < wanted; ++i) {
+            ++result.candidates;
+            Judged& candidate = judged[i];
+            if (candidate.rejection) {
+                ++result.rejected[int(*candidate.rejection)];
+                continue;
+            }
+            const double distance = thumbnailDistance(candidate.thumbnail.pixels, original);
+            bool similar = distance < result.minimumDistance;
+            for (const auto& other : accepted)
+                similar = similar || thumbnailDistance(candidate.thumbnail.pixels, other) < result.minimumDistance;
+            if (similar) {
+                ++result.rejected[int(Rejection::Similar)];
+                continue;
+            }
+            Variation variation;
+            variation.params = std::move(candidate.params);
+            variation.params.description = describe(base.description, options, int(result.variations.size()) + 1);
+            variation.measures = {candidate.thumbnail.coverage(), std::cbrt(candidate.thumbnail.roughnessCubed()),
+                                  distance};
+            variation.candidate = next + i;
+            accepted.push_back(std::move(candidate.thumbnail.pixels));
+            result.variations.push_back(std::move(variation));
+        }
+        if (progress && !progress(double(result.variations.size()) / wanted)) throw Cancelled();
+    }
+    return result;
+}
+
 }  // namespace
 
 std::span<const StrengthName> strengthNames() { return kStrengths; }
@@ -417,43 +459,8 @@ VariationResult vary(const Params& base, const VariationOptions& options, const 
                                                   "which is locked: every variation would be dust; unlock " +
                                                   groupNames(dust));
 
-    VariationResult result;
-    result.minimumDistance = minimumDistance(options.strength);
     const int limit = options.maxCandidates > 0 ? options.maxCandidates : 60 * options.count;
-    const Slice baseSlice = base.slice.effective();
-    std::vector<std::vector<std::uint16_t>> accepted;
-    if (progress && !progress(0.0)) throw Cancelled();
-    constexpr int kBlock = 8;  // candidates measured in parallel, then judged in their order
-    for (int next = 0; int(result.variations.size()) < options.count && next < limit; next += kBlock) {
-        const int size = std::min(kBlock, limit - next);
-        std::vector<Judged> judged(size);
-        tbb::parallel_for(0, size, [&](int i) { judged[i] = judge(candidateFor(base, baseSlice, options, next + i)); });
-        for (int i = 0; i < size && int(result.variations.size()) < options.count; ++i) {
-            ++result.candidates;
-            Judged& candidate = judged[i];
-            if (candidate.rejection) {
-                ++result.rejected[int(*candidate.rejection)];
-                continue;
-            }
-            const double distance = thumbnailDistance(candidate.thumbnail.pixels, original.pixels);
-            bool similar = distance < result.minimumDistance;
-            for (const auto& other : accepted)
-                similar = similar || thumbnailDistance(candidate.thumbnail.pixels, other) < result.minimumDistance;
-            if (similar) {
-                ++result.rejected[int(Rejection::Similar)];
-                continue;
-            }
-            Variation variation;
-            variation.params = std::move(candidate.params);
-            variation.params.description = describe(base.description, options, int(result.variations.size()) + 1);
-            variation.measures = {candidate.thumbnail.coverage(), std::cbrt(candidate.thumbnail.roughnessCubed()),
-                                  distance};
-            variation.candidate = next + i;
-            accepted.push_back(std::move(candidate.thumbnail.pixels));
-            result.variations.push_back(std::move(variation));
-        }
-        if (progress && !progress(double(result.variations.size()) / options.count)) throw Cancelled();
-    }
+    VariationResult result = search(base, original.pixels, options, limit, options.count, progress);
     if (int(result.variations.size()) < options.count) {
         std::string counts;
         for (int r = 0; r < kRejectionCount; ++r)
@@ -474,6 +481,10 @@ VariationResult vary(const Params& base, const VariationOptions& options, const 
     }
     if (progress && !progress(1.0)) throw Cancelled();
     return result;
+}
+
+VariationResult sampleVariations(const Params& base, const VariationOptions& options, int candidates) {
+    return search(base, thumbnail(base).pixels, options, candidates, candidates, {});
 }
 
 }  // namespace dqj

@@ -118,6 +118,10 @@ DQJ_API double minimumDistance(double strength);
 /// settings); Cancelled if `progress` returns false.
 DQJ_API VariationResult vary(const Params& base, const VariationOptions& options, const ProgressCallback& progress = {});
 
+/// Judges exactly `candidates` candidates of vary()'s sequence and keeps every one that passes
+/// (for the measures' figures: docs/variations.md, the benchmark). No checks of the settings.
+DQJ_API VariationResult sampleVariations(const Params& base, const VariationOptions& options, int candidates);
+
 /// A document's depth thumbnail (kThumbnail^2 pixels, row 0 at the top: 2 kThumbnail - depth on
 /// the set, 0 off it), and the image distance of two of them (for tests and the benchmark).
 DQJ_API std::vector<std::uint16_t> thumbnailOf(const Params& params);
