@@ -361,7 +361,8 @@ int main(int argc, char** argv) {
             1e3 / packet->second, 1e3 / scalar->second, packet->second / scalar->second);
     const auto variations = reporter.counters.find("variations/grid9_128px/real_time");
     if (variations != reporter.counters.end())
-        std::printf("variations, the first grid of nine 128x128 thumbnails: first %.0f ms, last %.0f ms (target: last <= 1000 ms)\n",
-                    variations->second.first, variations->second.second);
+        std::printf(
+            "variations, the first grid of nine 128x128 thumbnails: first %.0f ms, last %.0f ms (target: last <= 1000 ms)\n",
+            variations->second.first, variations->second.second);
     return 0;
 }

@@ -55,8 +55,8 @@ void registerVariationBenchmarks() {
 
 int printVariationFigures() {
     std::printf("variations of the default document, seed 1, the variant locked; 1,000 candidates a strength\n");
-    std::printf("%-7s %8s %8s %6s %6s %6s %6s %8s %8s  %s\n", "", "accepted", "invalid", "empty", "dust", "tiny", "ball",
-                "similar", "bound", "distance from the original: min / mean / max; closest pair");
+    std::printf("%-7s %8s %8s %6s %6s %6s %6s %8s %8s  %s\n", "", "accepted", "invalid", "empty", "dust", "tiny",
+                "ball", "similar", "bound", "distance from the original: min / mean / max; closest pair");
     for (const StrengthName& name : strengthNames()) {
         VariationOptions options;
         options.seed = 1;
@@ -76,7 +76,8 @@ int printVariationFigures() {
         for (std::size_t i = 0; i < grid.size(); ++i)
             for (std::size_t j = 0; j < i; ++j) closest = std::min(closest, thumbnailDistance(grid[i], grid[j]));
         std::printf("%-7s %8zu", std::string(name.name).c_str(), result.variations.size());
-        for (int r = 0; r < kRejectionCount; ++r) std::printf(" %*d", r == 0 || r == kRejectionCount - 1 ? 8 : 6, result.rejected[r]);
+        for (int r = 0; r < kRejectionCount; ++r)
+            std::printf(" %*d", r == 0 || r == kRejectionCount - 1 ? 8 : 6, result.rejected[r]);
         std::printf(" %8.3f  %.3f / %.3f / %.3f; first grid's closest pair %.3f\n", result.minimumDistance, low,
                     result.variations.empty() ? 0.0 : sum / double(result.variations.size()), high, closest);
     }

@@ -219,9 +219,10 @@ Runner addExploreCommand(CLI::App& app) {
         "complete parameter file for render, bake, povray or the next --around");
     options->fractal.addTo(*command);
     command->add_option("--seed", options->seed, "Random seed (the same seed gives the same constants)");
-    command->add_option("--around", options->around,
-                        "Variations of this parameter file instead of random constants (flags such as --c\n"
-                        "override its values first)")
+    command
+        ->add_option("--around", options->around,
+                     "Variations of this parameter file instead of random constants (flags such as --c\n"
+                     "override its values first)")
         ->check(existingFile());
     command->add_option("--strength", options->strength,
                         "With --around: how far the variations go: tiny (0.05, details move), small (0.15),\n"
@@ -232,8 +233,9 @@ Runner addExploreCommand(CLI::App& app) {
                         "none; default: variant");
     CLI::Option* count = command->add_option("--count", options->count, "Number of tiles (default 12; 9 with --around)")
                              ->check(CLI::Range(1, 100));
-    CLI::Option* columns = command->add_option("--columns", options->columns, "Tiles per row (default 4; 3 with --around)")
-                               ->check(CLI::Range(1, kMaxSheetColumns));
+    CLI::Option* columns =
+        command->add_option("--columns", options->columns, "Tiles per row (default 4; 3 with --around)")
+            ->check(CLI::Range(1, kMaxSheetColumns));
     command->add_option("--tile-width", options->width, "Tile width in pixels")->check(CLI::Range(16, 4096));
     command->add_option("--tile-height", options->height, "Tile height in pixels")->check(CLI::Range(16, 4096));
     command->add_option("-s,--samples", options->samples, "Anti-aliasing per tile: S x S rays a pixel")

@@ -606,9 +606,11 @@ dqj_status dqj_variations_compute(dqj_context context, uint64_t seed, double str
                   DQJ_GROUP_VARIANT == dqj::kGroupVariant && DQJ_GROUP_ALL == dqj::kAllVariationGroups);
     return guarded(context, [&](dqj_context_t& self) {
         if (!(strength >= dqj::kMinStrength && strength <= dqj::kMaxStrength))
-            return invalidArgument(self, "strength must be from 0.01 to 1 (DQJ_STRENGTH_TINY 0.05 ... DQJ_STRENGTH_HUGE 1)");
+            return invalidArgument(self,
+                                   "strength must be from 0.01 to 1 (DQJ_STRENGTH_TINY 0.05 ... DQJ_STRENGTH_HUGE 1)");
         if (count < 1 || count > 100) return invalidArgument(self, "count must be from 1 to 100");
-        if (lockedGroups & ~DQJ_GROUP_ALL) return invalidArgument(self, "locked_groups has bits other than DQJ_GROUP_*");
+        if (lockedGroups & ~DQJ_GROUP_ALL)
+            return invalidArgument(self, "locked_groups has bits other than DQJ_GROUP_*");
         if (lockedGroups == DQJ_GROUP_ALL)
             return invalidArgument(self, "every group is locked: nothing may change; unlock at least one DQJ_GROUP_*");
         dqj::VariationOptions options;
@@ -616,8 +618,8 @@ dqj_status dqj_variations_compute(dqj_context context, uint64_t seed, double str
         options.strength = strength;
         options.locked = lockedGroups;
         options.count = int(count);
-        self.variations = dqj::vary(dqj::stillAtFrame(paramsNow(self), self.frame), options,
-                                    wrapProgress(progress, userData));
+        self.variations =
+            dqj::vary(dqj::stillAtFrame(paramsNow(self), self.frame), options, wrapProgress(progress, userData));
         return DQJ_OK;
     });
 }

@@ -82,7 +82,9 @@ std::array<double, Size> unitVector(Random& random) {
 double rounded(double value, double scale = 1e5) { return std::round(value * scale) / scale + 0.0; }
 
 /// An amount between half and all of `reach * strength`: the strength sets the size of a change.
-double amount(Random& random, double reach, double strength) { return reach * strength * (0.5 + 0.5 * random.uniform()); }
+double amount(Random& random, double reach, double strength) {
+    return reach * strength * (0.5 + 0.5 * random.uniform());
+}
 
 /// 1 + x or 1 / (1 + x): a factor that grows or shrinks by the same step.
 double factor(Random& random, double step) {
@@ -237,8 +239,7 @@ Params candidateFor(const Params& base, const Slice& baseSlice, const VariationO
     const double iterationFactor = factor(random, amount(random, 0.6, s));
     const double bailoutFactor = factor(random, amount(random, 0.5, s));
     if (open & kGroupIterations) {
-        params.fractal.iterations =
-            std::clamp(int(std::lround(base.fractal.iterations * iterationFactor)), 1, 100000);
+        params.fractal.iterations = std::clamp(int(std::lround(base.fractal.iterations * iterationFactor)), 1, 100000);
         params.fractal.bailout = rounded(base.fractal.bailout * bailoutFactor);
     }
 
@@ -393,10 +394,12 @@ std::optional<unsigned> parseGroups(std::string_view text, std::string* unknown)
 }
 
 std::string groupNames(unsigned groups) {
-    static constexpr std::pair<unsigned, std::string_view> kNames[] = {
-        {kGroupA, "a"},          {kGroupB, "b"},
-        {kGroupSliceOrientation, "slice orientation"}, {kGroupSliceOrigin, "slice origin"},
-        {kGroupIterations, "iterations"},             {kGroupVariant, "variant"}};
+    static constexpr std::pair<unsigned, std::string_view> kNames[] = {{kGroupA, "a"},
+                                                                       {kGroupB, "b"},
+                                                                       {kGroupSliceOrientation, "slice orientation"},
+                                                                       {kGroupSliceOrigin, "slice origin"},
+                                                                       {kGroupIterations, "iterations"},
+                                                                       {kGroupVariant, "variant"}};
     std::string text;
     for (const auto& [bit, name] : kNames)
         if (groups & bit) text += (text.empty() ? "" : ", ") + std::string(name);
@@ -430,29 +433,34 @@ double thumbnailDistance(const std::vector<std::uint16_t>& first, const std::vec
 
 VariationResult vary(const Params& base, const VariationOptions& options, const ProgressCallback& progress) {
     if (!(options.strength >= kMinStrength && options.strength <= kMaxStrength))
-        throw ParamError("variations.strength", "strength " + number(options.strength) + " is out of range: give " +
-                                                    number(kMinStrength) + " to " + number(kMaxStrength) +
-                                                    " or tiny (0.05), small (0.15), medium (0.3), large (0.6), huge (1)");
+        throw ParamError("variations.strength",
+                         "strength " + number(options.strength) + " is out of range: give " + number(kMinStrength) +
+                             " to " + number(kMaxStrength) +
+                             " or tiny (0.05), small (0.15), medium (0.3), large (0.6), huge (1)");
     if (options.count < 1 || options.count > 100)
-        throw ParamError("variations.count", "count " + std::to_string(options.count) + " is out of range: give 1 to 100");
+        throw ParamError("variations.count",
+                         "count " + std::to_string(options.count) + " is out of range: give 1 to 100");
     if ((options.locked & kAllVariationGroups) == kAllVariationGroups)
         throw ParamError("variations.locked",
                          "every group is locked (a, b, slice orientation, slice origin, iterations, variant): nothing "
                          "may change; unlock at least one");
     if (!base.animation.empty())
-        throw ParamError("animation", "the document is animated: vary a still (the parameters of one frame, "
-                                      "e.g. from the C ABI at the context's frame, or without \"animation\")");
+        throw ParamError("animation",
+                         "the document is animated: vary a still (the parameters of one frame, "
+                         "e.g. from the C ABI at the context's frame, or without \"animation\")");
     validate(base);
     const InspectReport start = inspect(base, 16);
     if (!start.emptyReason.empty())
-        throw ParamError("fractal", "the starting document is itself empty, so there is nothing to vary: " +
-                                        start.emptyReason);
+        throw ParamError("fractal",
+                         "the starting document is itself empty, so there is nothing to vary: " + start.emptyReason);
     const Thumbnail original = thumbnail(base);
     if (original.inside == 0)
-        throw ParamError("fractal", "the starting document is itself empty, so there is nothing to vary: no point of "
-                                    "its " + std::to_string(kThumbnail) + "^3 thumbnail lattice is inside at N = " +
-                                        std::to_string(base.fractal.iterations) +
-                                        "; try more samples of the fractal with fewer iterations");
+        throw ParamError("fractal",
+                         "the starting document is itself empty, so there is nothing to vary: no point of "
+                         "its " +
+                             std::to_string(kThumbnail) +
+                             "^3 thumbnail lattice is inside at N = " + std::to_string(base.fractal.iterations) +
+                             "; try more samples of the fractal with fewer iterations");
     if (const unsigned dust = dustParts(start) & options.locked; dust != 0)
         throw ParamError("variations.locked", "the starting document is dust in " + groupNames(dust) +
                                                   " (its equivalent complex constant lies outside the Mandelbrot set), "
@@ -467,17 +475,17 @@ VariationResult vary(const Params& base, const VariationOptions& options, const 
             if (result.rejected[r])
                 counts += (counts.empty() ? "" : ", ") + std::to_string(result.rejected[r]) + " " +
                           std::string(rejectionName(Rejection(r)));
-        throw ParamError("variations",
-                         "found only " + std::to_string(result.variations.size()) + " of " +
-                             std::to_string(options.count) + " variations in " + std::to_string(result.candidates) +
-                             " candidates (rejected: " + counts + "); loosen the settings: " +
-                             (options.strength < kMaxStrength ? "raise the strength (now " +
-                                                                    strengthText(options.strength) + "), "
-                                                              : std::string()) +
-                             ((options.locked & kAllVariationGroups) ? "unlock groups (locked: " +
-                                                                           groupNames(options.locked) + "), "
-                                                                     : std::string()) +
-                             "ask for fewer variations, or try another seed");
+        throw ParamError("variations", "found only " + std::to_string(result.variations.size()) + " of " +
+                                           std::to_string(options.count) + " variations in " +
+                                           std::to_string(result.candidates) + " candidates (rejected: " + counts +
+                                           "); loosen the settings: " +
+                                           (options.strength < kMaxStrength
+                                                ? "raise the strength (now " + strengthText(options.strength) + "), "
+                                                : std::string()) +
+                                           ((options.locked & kAllVariationGroups)
+                                                ? "unlock groups (locked: " + groupNames(options.locked) + "), "
+                                                : std::string()) +
+                                           "ask for fewer variations, or try another seed");
     }
     if (progress && !progress(1.0)) throw Cancelled();
     return result;

@@ -2,6 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdlib>
+#include <bit>
 #include <cstring>
 
 #include "dqjulia/inspect.hpp"
@@ -20,6 +21,21 @@ VariationOptions options(std::uint64_t seed, double strength, unsigned locked = 
     o.locked = locked;
     o.count = count;
     return o;
+}
+
+/// Bit for bit: every double of `x` and `y` (a double, a quaternion, an array of doubles or of
+/// arrays) has the same bits, so -0 and 0 differ and a NaN equals only itself.
+bool same(double x, double y) { return std::bit_cast<std::uint64_t>(x) == std::bit_cast<std::uint64_t>(y); }
+bool same(const dqj::Quat& x, const dqj::Quat& y) {
+    for (int k = 0; k < 4; ++k)
+        if (!same(dqj::component(x, k), dqj::component(y, k))) return false;
+    return true;
+}
+template <typename T, std::size_t N>
+bool same(const std::array<T, N>& x, const std::array<T, N>& y) {
+    for (std::size_t k = 0; k < N; ++k)
+        if (!same(x[k], y[k])) return false;
+    return true;
 }
 
 double meanDistance(const dqj::VariationResult& result) {
@@ -64,14 +80,14 @@ TEST(Variations, LockedGroupsStayBitForBit) {
     Params base;
     base.slice.rotations = {dqj::PlaneRotation{2, 4, 12.5}};
     base.slice.base.origin[6] = 0.125;
-    for (const unsigned locked : {dqj::kGroupA | dqj::kGroupVariant, dqj::kGroupB | dqj::kGroupIterations | dqj::kGroupVariant,
-                                  dqj::kGroupSliceOrientation | dqj::kGroupSliceOrigin | dqj::kGroupVariant,
-                                  dqj::kAllVariationGroups & ~dqj::kGroupA}) {
+    for (const unsigned locked :
+         {dqj::kGroupA | dqj::kGroupVariant, dqj::kGroupB | dqj::kGroupIterations | dqj::kGroupVariant,
+          dqj::kGroupSliceOrientation | dqj::kGroupSliceOrigin | dqj::kGroupVariant,
+          dqj::kAllVariationGroups & ~dqj::kGroupA}) {
         const dqj::VariationResult result = dqj::vary(base, options(5, 0.6, locked, 6));
         ASSERT_EQ(result.variations.size(), 6u);
         for (const dqj::Variation& variation : result.variations) {
             const Params& p = variation.params;
-            auto same = [](const auto& x, const auto& y) { return std::memcmp(&x, &y, sizeof x) == 0; };
             if (locked & dqj::kGroupA) EXPECT_TRUE(same(p.fractal.c.a, base.fractal.c.a));
             if (locked & dqj::kGroupB) EXPECT_TRUE(same(p.fractal.c.b, base.fractal.c.b));
             if (locked & dqj::kGroupIterations) {
@@ -105,7 +121,8 @@ TEST(Variations, StrengthRaisesTheMeanDistanceFromTheOriginal) {
     double previous = 0.0;
     for (const dqj::StrengthName& name : dqj::strengthNames()) {
         double sum = 0.0;
-        for (const std::uint64_t seed : {1u, 2u, 3u}) sum += meanDistance(dqj::vary(Params(), options(seed, name.value)));
+        for (const std::uint64_t seed : {1u, 2u, 3u})
+            sum += meanDistance(dqj::vary(Params(), options(seed, name.value)));
         const double mean = sum / 3.0;
         EXPECT_GT(mean, previous) << name.name;
         previous = mean;
@@ -116,12 +133,14 @@ TEST(Variations, NoTwoThumbnailsNearlyTheSame) {
     for (const double strength : {0.05, 0.6}) {
         const dqj::VariationResult result = dqj::vary(Params(), options(11, strength));
         std::vector<std::vector<std::uint16_t>> thumbnails;
-        for (const dqj::Variation& variation : result.variations) thumbnails.push_back(dqj::thumbnailOf(variation.params));
+        for (const dqj::Variation& variation : result.variations)
+            thumbnails.push_back(dqj::thumbnailOf(variation.params));
         const auto original = dqj::thumbnailOf(Params());
         for (std::size_t i = 0; i < thumbnails.size(); ++i) {
             EXPECT_GE(dqj::thumbnailDistance(thumbnails[i], original), dqj::minimumDistance(strength));
             for (std::size_t j = 0; j < i; ++j)
-                EXPECT_GE(dqj::thumbnailDistance(thumbnails[i], thumbnails[j]), dqj::minimumDistance(strength)) << i << j;
+                EXPECT_GE(dqj::thumbnailDistance(thumbnails[i], thumbnails[j]), dqj::minimumDistance(strength))
+                    << i << j;
         }
     }
 }
@@ -162,7 +181,8 @@ TEST(Variations, BadInputGetsAClearMessage) {
     EXPECT_NE(failure(base, options(1, 1.5)).find("strength 1.5 is out of range"), std::string::npos);
     EXPECT_NE(failure(base, options(1, 0.0)).find("out of range"), std::string::npos);
     EXPECT_NE(failure(base, options(1, std::nan(""))).find("out of range"), std::string::npos);
-    EXPECT_NE(failure(base, options(1, 0.3, dqj::kAllVariationGroups)).find("every group is locked"), std::string::npos);
+    EXPECT_NE(failure(base, options(1, 0.3, dqj::kAllVariationGroups)).find("every group is locked"),
+              std::string::npos);
     EXPECT_NE(failure(base, options(1, 0.3, 0, 0)).find("count 0"), std::string::npos);
     // A starting document that is itself empty: the dual part's own orbit escapes.
     Params empty;
@@ -189,8 +209,7 @@ TEST(Variations, BoundedTriesSayHowToLoosenTheSettings) {
 }
 
 TEST(Variations, ProgressCanCancel) {
-    EXPECT_THROW(dqj::vary(Params(), options(1, 0.3), [](double fraction) { return fraction < 0.01; }),
-                 dqj::Cancelled);
+    EXPECT_THROW(dqj::vary(Params(), options(1, 0.3), [](double fraction) { return fraction < 0.01; }), dqj::Cancelled);
 }
 
 TEST(Variations, Figures) {

@@ -258,11 +258,11 @@ DQJ_API dqj_status dqj_bake_get_stats(dqj_context context, dqj_bake_stats* out_s
 #define DQJ_GROUP_ALL 0x3fu
 
 /* Strengths from 0.01 to 1, named as an artist would (Mandelbulber's Randomizer): */
-#define DQJ_STRENGTH_TINY 0.05   /* the same fractal with its details moved a little */
-#define DQJ_STRENGTH_SMALL 0.15  /* a close relative: the same overall form, different details */
-#define DQJ_STRENGTH_MEDIUM 0.3  /* a sibling: recognisably related, noticeably different */
-#define DQJ_STRENGTH_LARGE 0.6   /* a cousin: a different form from the same neighbourhood */
-#define DQJ_STRENGTH_HUGE 1.0    /* a stranger: anything the unlocked groups can reach */
+#define DQJ_STRENGTH_TINY 0.05  /* the same fractal with its details moved a little */
+#define DQJ_STRENGTH_SMALL 0.15 /* a close relative: the same overall form, different details */
+#define DQJ_STRENGTH_MEDIUM 0.3 /* a sibling: recognisably related, noticeably different */
+#define DQJ_STRENGTH_LARGE 0.6  /* a cousin: a different form from the same neighbourhood */
+#define DQJ_STRENGTH_HUGE 1.0   /* a stranger: anything the unlocked groups can reach */
 
 /* Computes `count` (1..100) variations and keeps them in the context, replacing the previous
  * ones (which are kept if this call fails). `locked_groups`: DQJ_GROUP_* bits that stay; at

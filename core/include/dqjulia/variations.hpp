@@ -74,10 +74,10 @@ DQJ_API std::string groupNames(unsigned groups);
 
 struct VariationOptions {
     std::uint64_t seed = 1;
-    double strength = 0.3;  ///< kMinStrength..kMaxStrength; "medium"
+    double strength = 0.3;            ///< kMinStrength..kMaxStrength; "medium"
     unsigned locked = kGroupVariant;  ///< groups kept bit for bit (the variant by default)
-    int count = 9;          ///< 1..100
-    int maxCandidates = 0;  ///< 0: 60 * count
+    int count = 9;                    ///< 1..100
+    int maxCandidates = 0;            ///< 0: 60 * count
 };
 
 /// The measures of one candidate's thumbnail (the header's comment defines them).
@@ -99,9 +99,9 @@ DQJ_API std::string_view rejectionName(Rejection rejection);
 
 struct VariationResult {
     std::vector<Variation> variations;
-    int candidates = 0;  ///< candidates judged (accepted and rejected)
+    int candidates = 0;                           ///< candidates judged (accepted and rejected)
     std::array<int, kRejectionCount> rejected{};  ///< by Rejection
-    double minimumDistance = 0.0;  ///< the bound every pair (and the original) kept
+    double minimumDistance = 0.0;                 ///< the bound every pair (and the original) kept
 };
 
 /// The thresholds (docs/variations.md says how they were chosen).
@@ -116,7 +116,8 @@ DQJ_API double minimumDistance(double strength);
 /// locked part, or otherwise invalid, and when fewer than `count` variations pass within
 /// maxCandidates (the message says how many were rejected by which measure and how to loosen the
 /// settings); Cancelled if `progress` returns false.
-DQJ_API VariationResult vary(const Params& base, const VariationOptions& options, const ProgressCallback& progress = {});
+DQJ_API VariationResult vary(const Params& base, const VariationOptions& options,
+                             const ProgressCallback& progress = {});
 
 /// Judges exactly `candidates` candidates of vary()'s sequence and keeps every one that passes
 /// (for the measures' figures: docs/variations.md, the benchmark). No checks of the settings.
