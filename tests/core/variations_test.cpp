@@ -1,7 +1,6 @@
 // Variations (variations.hpp): determinism, validity, locks, strength, diversity, bad input.
 #include <gtest/gtest.h>
 
-#include <cstdlib>
 #include <bit>
 #include <cstring>
 
@@ -210,32 +209,6 @@ TEST(Variations, BoundedTriesSayHowToLoosenTheSettings) {
 
 TEST(Variations, ProgressCanCancel) {
     EXPECT_THROW(dqj::vary(Params(), options(1, 0.3), [](double fraction) { return fraction < 0.01; }), dqj::Cancelled);
-}
-
-TEST(Variations, Figures) {
-    if (!std::getenv("DQJ_VARIATION_FIGURES")) GTEST_SKIP();
-    for (const dqj::StrengthName& name : dqj::strengthNames()) {
-        VariationOptions o = options(1, name.value, dqj::kGroupVariant, 100);
-        o.maxCandidates = 1000;
-        dqj::VariationResult result;
-        try {
-            result = dqj::vary(Params(), o);
-        } catch (const dqj::ParamError& e) {
-            std::printf("%s\n", e.what());
-            continue;
-        }
-        double lo = 1, hi = 0, sum = 0;
-        for (auto& v : result.variations) {
-            lo = std::min(lo, v.measures.distance);
-            hi = std::max(hi, v.measures.distance);
-            sum += v.measures.distance;
-        }
-        std::printf("%s: %d candidates, accepted %zu, rejected", std::string(name.name).c_str(), result.candidates,
-                    result.variations.size());
-        for (int r = 0; r < dqj::kRejectionCount; ++r)
-            std::printf(" %s %d", std::string(dqj::rejectionName(dqj::Rejection(r))).c_str(), result.rejected[r]);
-        std::printf("; distance min %.3f mean %.3f max %.3f\n", lo, sum / result.variations.size(), hi);
-    }
 }
 
 }  // namespace
