@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 
 #include <bit>
-#include <cstring>
+#include <cmath>
 
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/params.hpp"
