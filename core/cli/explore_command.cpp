@@ -218,7 +218,7 @@ Runner addExploreCommand(CLI::App& app) {
         "not too small, no two alike); writes sheet.png and, per tile, tile_NN.png and tile_NN.json, a\n"
         "complete parameter file for render, bake, povray or the next --around");
     options->fractal.addTo(*command);
-    command->add_option("--seed", options->seed, "Random seed (the same seed gives the same constants)");
+    command->add_option("--seed", options->seed, "Random seed (the same seed gives the same constants, or variations)");
     command
         ->add_option("--around", options->around,
                      "Variations of this parameter file instead of random constants (flags such as --c\n"
