@@ -34,7 +34,7 @@
  * Separate contexts are independent and may be used from different threads at the same
  * time. One context is used by one call at a time (a second call meanwhile is refused with
  * DQJ_ERROR_BUSY, not queued); its progress callback runs on the thread that called dqj_render*(),
- * dqj_bake_vdb() or dqj_mesh_compute().
+ * dqj_bake_vdb(), dqj_mesh_compute() or dqj_variations_compute().
  */
 #ifndef DQJULIA_H
 #define DQJULIA_H
