@@ -1,6 +1,7 @@
 // Variations (variations.hpp): determinism, validity, locks, strength, diversity, bad input.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <bit>
 #include <cmath>
 
@@ -146,6 +147,44 @@ TEST(Variations, NoTwoThumbnailsNearlyTheSame) {
                     << i << j;
         }
     }
+}
+
+/// What each measure rejected among the first `candidates` candidates.
+std::array<int, dqj::kRejectionCount> rejected(const Params& base, double strength, unsigned locked, int candidates) {
+    return dqj::sampleVariations(base, options(1, strength, locked), candidates).rejected;
+}
+
+int count(const std::array<int, dqj::kRejectionCount>& counts, dqj::Rejection rejection) {
+    return counts[int(rejection)];
+}
+
+TEST(Variations, EachMeasureRejectsWhatItShould) {
+    using dqj::Rejection;
+    const unsigned variant = dqj::kGroupVariant;
+    // Near c = 0 the Julia set is a ball (z^2 + 0: the unit ball exactly).
+    Params ball;
+    ball.fractal.c = {dqj::makeQuat(0.02, 0.01, 0, 0), dqj::makeQuat(0, 0, 0, 0)};
+    const auto balls = rejected(ball, 0.05, variant, 24);
+    EXPECT_GE(count(balls, Rejection::Ball), 20) << "ball";
+    // Bounds far wider than the set (radius 7): it covers under 2% of the frame.
+    // Every candidate is rejected: as tiny, or as dust (the default constant lies near the edge).
+    Params far;
+    far.bounds = dqj::Bounds{glm::dvec3(0.0), 7.0};
+    const auto tiny = rejected(far, 0.05, variant, 16);
+    EXPECT_GE(count(tiny, Rejection::Tiny), 6) << "tiny";
+    EXPECT_EQ(count(tiny, Rejection::Tiny) + count(tiny, Rejection::Dust), 16) << "tiny";
+    // The default constant's real part lies near the Mandelbrot set's edge: large steps leave it
+    // (dust) or empty the slice.
+    const auto huge = rejected(Params(), 1.0, variant, 48);
+    EXPECT_GT(count(huge, Rejection::Dust), 0);
+    EXPECT_GT(count(huge, Rejection::Empty), 0);
+    // Tiny steps of only the iterations group: the same picture as the original.
+    const auto same = rejected(Params(), 0.05, dqj::kAllVariationGroups & ~dqj::kGroupIterations, 16);
+    EXPECT_EQ(count(same, Rejection::Similar), 16) << "similar";
+    // R at its least allowed value, and locked: a constant that needs a larger R is invalid.
+    Params tight;
+    tight.fractal.bailout = dqj::minimumBailout(tight.fractal);
+    EXPECT_GT(count(rejected(tight, 0.3, dqj::kGroupIterations | variant, 24), Rejection::Invalid), 0) << "invalid";
 }
 
 TEST(Variations, ThumbnailDistanceIsAJaccardDistance) {
