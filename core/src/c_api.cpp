@@ -639,6 +639,7 @@ dqj_status dqj_variations_get_json(dqj_context context, char* buffer, size_t cap
                                               {"coverage", variation.measures.coverage},
                                               {"roughness", variation.measures.roughness},
                                               {"distance", variation.measures.distance},
+                                              {"connected", variation.measures.connected},
                                               {"description", variation.params.description}});
         return copyText(self, document.dump(2) + "\n", buffer, capacity, outSize);
     });

@@ -97,6 +97,8 @@ struct Thumbnail {
     std::vector<std::uint16_t> pixels;  ///< kThumbnail^2, row 0 at the top: 2G - depth on the set, 0 off it
     std::int64_t inside = 0;            ///< lattice points inside at N
     std::int64_t faces = 0;             ///< faces between inside points and outside ones (or the lattice's edge)
+    std::int64_t largest = 0;           ///< inside points in the largest piece (26-connected)
+    double connected() const { return inside == 0 ? 0.0 : double(largest) / double(inside); }
     double coverage() const {
         return double(std::count_if(pixels.begin(), pixels.end(), [](std::uint16_t v) { return v != 0; })) /
                double(pixels.size());
@@ -155,8 +157,34 @@ Thumbnail thumbnail(const Params& params) {
                 std::uint16_t& pixel = result.pixels[std::size_t(y) * g + x];
                 if (pixel == 0) pixel = std::uint16_t(2 * g - z);
             }
+    // The pieces: flood fills over the 26 neighbours, marking each point when it is reached.
+    std::vector<int> stack;
+    for (std::size_t seed = 0; seed < in.size(); ++seed) {
+        if (in[seed] != 1) continue;
+        std::int64_t size = 0;
+        in[seed] = 2;
+        stack.assign(1, int(seed));
+        while (!stack.empty()) {
+            const int at = stack.back();
+            stack.pop_back();
+            ++size;
+            const int x = at % g, y = at / g % g, z = at / (g * g);
+            for (int dz = -1; dz <= 1; ++dz)
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dx = -1; dx <= 1; ++dx) {
+                        const int nx = x + dx, ny = y + dy, nz = z + dz;
+                        if (nx < 0 || ny < 0 || nz < 0 || nx >= g || ny >= g || nz >= g) continue;
+                        const int next = (nz * g + ny) * g + nx;
+                        if (in[std::size_t(next)] != 1) continue;
+                        in[std::size_t(next)] = 2;
+                        stack.push_back(next);
+                    }
+        }
+        result.largest = std::max(result.largest, size);
+    }
     return result;
 }
+
 
 /// The parts whose constant decides escape: a always, b too except under "dual".
 unsigned decidingParts(const Fractal& fractal) {
@@ -168,6 +196,17 @@ unsigned dustParts(const InspectReport& report) {
     const unsigned deciding = decidingParts(report.fractal);
     return ((deciding & kGroupA) && !report.real.inMandelbrot ? kGroupA : 0u) |
            ((deciding & kGroupB) && !report.dual.inMandelbrot ? kGroupB : 0u);
+}
+
+/// Dust: a part that decides escape lies outside the Mandelbrot set (inspect: its Julia set is
+/// totally disconnected) where the original's was inside, or the set at N already falls apart (its
+/// largest piece holds less than kMinConnected of its points). A variation never turns a fractal
+/// into dust; one already beyond the Mandelbrot set's edge (as the paper's "test2" figures are),
+/// whose set at N is still one solid, is varied as it is. `outsideBefore`: the original's parts
+/// outside the Mandelbrot set (dustParts).
+bool isDust(const InspectReport& report, const Thumbnail& thumbnail, unsigned outsideBefore) {
+    const unsigned outside = dustParts(report);
+    return (outside & ~outsideBefore) != 0 || (outside != 0 && thumbnail.connected() < kMinConnected);
 }
 
 /// Candidate `index` of the seed's sequence. Every group's change is drawn whether it is
@@ -267,7 +306,7 @@ struct Judged {
     Thumbnail thumbnail;
 };
 
-Judged judge(Params params) {
+Judged judge(Params params, unsigned outsideBefore) {
     Judged judged;
     try {
         validate(params);
@@ -278,12 +317,12 @@ Judged judge(Params params) {
     const InspectReport report = inspect(params, 16);
     if (!report.emptyReason.empty()) {
         judged.rejection = Rejection::Empty;
-    } else if (dustParts(report) != 0) {
-        judged.rejection = Rejection::Dust;
     } else {
         judged.thumbnail = thumbnail(params);
         if (judged.thumbnail.inside == 0)
             judged.rejection = Rejection::Empty;
+        else if (isDust(report, judged.thumbnail, outsideBefore))
+            judged.rejection = Rejection::Dust;
         else if (judged.thumbnail.coverage() < kMinCoverage)
             judged.rejection = Rejection::Tiny;
         else if (judged.thumbnail.roughnessCubed() < kMinRoughness * kMinRoughness * kMinRoughness)
@@ -319,6 +358,7 @@ std::string describe(const std::string& original, const VariationOptions& option
 /// Judges candidates 0, 1, ... in order until `wanted` pass or `limit` were judged.
 VariationResult search(const Params& base, const std::vector<std::uint16_t>& original, const VariationOptions& options,
                        int limit, int wanted, const ProgressCallback& progress) {
+    const unsigned outsideBefore = dustParts(inspect(base, 16));
     VariationResult result;
     result.minimumDistance = minimumDistance(options.strength);
     const Slice baseSlice = base.slice.effective();
@@ -328,7 +368,7 @@ VariationResult search(const Params& base, const std::vector<std::uint16_t>& ori
     for (int next = 0; int(result.variations.size()) < wanted && next < limit; next += kBlock) {
         const int size = std::min(kBlock, limit - next);
         std::vector<Judged> judged(size);
-        tbb::parallel_for(0, size, [&](int i) { judged[i] = judge(candidateFor(base, baseSlice, options, next + i)); });
+        tbb::parallel_for(0, size, [&](int i) { judged[i] = judge(candidateFor(base, baseSlice, options, next + i), outsideBefore); });
         for (int i = 0; i < size && int(result.variations.size()) < wanted; ++i) {
             ++result.candidates;
             Judged& candidate = judged[i];
@@ -348,7 +388,7 @@ VariationResult search(const Params& base, const std::vector<std::uint16_t>& ori
             variation.params = std::move(candidate.params);
             variation.params.description = describe(base.description, options, int(result.variations.size()) + 1);
             variation.measures = {candidate.thumbnail.coverage(), std::cbrt(candidate.thumbnail.roughnessCubed()),
-                                  distance};
+                                  distance, candidate.thumbnail.connected()};
             variation.candidate = next + i;
             accepted.push_back(std::move(candidate.thumbnail.pixels));
             result.variations.push_back(std::move(variation));
@@ -449,7 +489,7 @@ VariationResult vary(const Params& base, const VariationOptions& options, const 
                          "the document is animated: vary a still (the parameters of one frame, "
                          "e.g. from the C ABI at the context's frame, or without \"animation\")");
     validate(base);
-    const InspectReport start = inspect(base, 16);
+    const InspectReport start = inspect(base);  // 32^3 samples: a sparse start is given the benefit of the doubt
     if (!start.emptyReason.empty())
         throw ParamError("fractal",
                          "the starting document is itself empty, so there is nothing to vary: " + start.emptyReason);
@@ -460,13 +500,7 @@ VariationResult vary(const Params& base, const VariationOptions& options, const 
                          "its " +
                              std::to_string(kThumbnail) +
                              "^3 thumbnail lattice is inside at N = " + std::to_string(base.fractal.iterations) +
-                             "; try more samples of the fractal with fewer iterations");
-    if (const unsigned dust = dustParts(start) & options.locked; dust != 0)
-        throw ParamError("variations.locked", "the starting document is dust in " + groupNames(dust) +
-                                                  " (its equivalent complex constant lies outside the Mandelbrot set), "
-                                                  "which is locked: every variation would be dust; unlock " +
-                                                  groupNames(dust));
-
+                             "; try fewer iterations or another slice");
     const int limit = options.maxCandidates > 0 ? options.maxCandidates : 60 * options.count;
     VariationResult result = search(base, original.pixels, options, limit, options.count, progress);
     if (int(result.variations.size()) < options.count) {

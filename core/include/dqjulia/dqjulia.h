@@ -276,7 +276,7 @@ DQJ_API dqj_status dqj_variations_compute(dqj_context context, uint64_t seed, do
                                           uint32_t count, dqj_progress_fn progress, void* user_data);
 /* The context's variations as JSON: {"count", "candidates", "rejected": {"invalid", "empty",
  * "dust", "tiny", "ball", "similar"}, "minimum_distance", "variations": [{"candidate",
- * "coverage", "roughness", "distance", "description"}, ...]} (count 0 before the first
+ * "coverage", "roughness", "distance", "connected", "description"}, ...]} (count 0 before the first
  * dqj_variations_compute). Same buffer convention as dqj_context_get_params_json. */
 DQJ_API dqj_status dqj_variations_get_json(dqj_context context, char* buffer, size_t capacity, size_t* out_size);
 /* Variation `index` (0-based) as a complete parameter document, exactly as

@@ -14,7 +14,11 @@
 //   empty   inspect() proves the slice empty or finds no sample inside (16^3), or the
 //           thumbnail grid below has no point inside;
 //   dust    a part that decides escape (a; b too except under "dual") has its equivalent complex
-//           constant outside the Mandelbrot set (inspect(): the Julia set is totally disconnected);
+//           constant outside the Mandelbrot set (inspect(): the Julia set is totally disconnected)
+//           where the original's was inside; or, outside it, the set at N already falls apart
+//           (its largest 26-connected piece on the thumbnail lattice holds less than
+//           kMinConnected of its points). So a variation never turns a fractal into dust, and a
+//           document beyond the set's edge (the paper's "test2" figures) is varied as it is;
 //   tiny    the set covers less than kMinCoverage of its thumbnail (the render's frame);
 //   ball    its surface is less than kMinRoughness times a ball's of the same volume;
 //   similar its thumbnail differs from the original's, or from one accepted before it, by less
@@ -85,6 +89,7 @@ struct VariationMeasures {
     double coverage = 0.0;   ///< share of the thumbnail's pixels on the set
     double roughness = 0.0;  ///< surface / a ball's of the same volume (1 = ball)
     double distance = 0.0;   ///< image distance to the original's thumbnail
+    double connected = 0.0;  ///< share of the set's lattice points in its largest piece
 };
 
 struct Variation {
@@ -108,12 +113,13 @@ struct VariationResult {
 inline constexpr int kThumbnail = 40;
 inline constexpr double kMinCoverage = 0.02;
 inline constexpr double kMinRoughness = 1.25;
+inline constexpr double kMinConnected = 0.5;
 /// The smallest image distance between two variations, and from the original, at a strength.
 DQJ_API double minimumDistance(double strength);
 
 /// `count` variations of `base` (a still: no "animation"). Throws ParamError for a bad
-/// strength, count or lock (key "variations.*"), a starting document that is empty, dust in a
-/// locked part, or otherwise invalid, and when fewer than `count` variations pass within
+/// strength, count or lock (key "variations.*"), a starting document that is empty or otherwise
+/// invalid, and when fewer than `count` variations pass within
 /// maxCandidates (the message says how many were rejected by which measure and how to loosen the
 /// settings); Cancelled if `progress` returns false.
 DQJ_API VariationResult vary(const Params& base, const VariationOptions& options,
