@@ -6,7 +6,8 @@
 //
 // `dqjulia_bench --variation-figures` prints, instead of benchmarking, the figures of
 // docs/variations.md: per strength, what each measure rejected in a sample of 1,000 candidates
-// and the image distances of the variations that passed.
+// and the image distances of the variations that passed, around the default document and around
+// the paper's test2 tile 2 (beyond the Mandelbrot set's edge).
 #include "variations_bench.hpp"
 
 #include <benchmark/benchmark.h>
@@ -15,6 +16,8 @@
 #include <chrono>
 #include <cstdio>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "dqjulia/render.hpp"
 #include "dqjulia/variations.hpp"
@@ -54,32 +57,40 @@ void registerVariationBenchmarks() {
 }
 
 int printVariationFigures() {
-    std::printf("variations of the default document, seed 1, the variant locked; 1,000 candidates a strength\n");
-    std::printf("%-7s %8s %8s %6s %6s %6s %6s %8s %8s  %s\n", "", "accepted", "invalid", "empty", "dust", "tiny",
-                "ball", "similar", "bound", "distance from the original: min / mean / max; closest pair");
-    for (const StrengthName& name : strengthNames()) {
-        VariationOptions options;
-        options.seed = 1;
-        options.strength = name.value;
-        const VariationResult result = sampleVariations(Params(), options, 1000);
-        double low = 1.0, high = 0.0, sum = 0.0;
-        for (const Variation& variation : result.variations) {
-            low = std::min(low, variation.measures.distance);
-            high = std::max(high, variation.measures.distance);
-            sum += variation.measures.distance;
+    // The default document (its constant inside the Mandelbrot set, near the edge), and the
+    // paper's test2 tile 2 (examples/paper-test2-2.json: the real part just outside, N = 8).
+    Params beyond;
+    beyond.fractal.c = {makeQuat(-0.67, -0.54, -0.07, 0.02), makeQuat(0.06, -0.53, 0.15, -0.27)};
+    beyond.fractal.iterations = 8;
+    for (const auto& [label, base] : {std::pair<const char*, Params>{"the default document", Params()},
+                                      std::pair<const char*, Params>{"paper-test2-2", beyond}}) {
+        std::printf("\nvariations of %s, seed 1, the variant locked; 1,000 candidates a strength\n", label);
+        std::printf("%-7s %8s %8s %6s %6s %6s %6s %8s %8s  %s\n", "", "accepted", "invalid", "empty", "dust", "tiny",
+                    "ball", "similar", "bound", "distance from the original: min / mean / max; closest pair");
+        for (const StrengthName& name : strengthNames()) {
+            VariationOptions options;
+            options.seed = 1;
+            options.strength = name.value;
+            const VariationResult result = sampleVariations(base, options, 1000);
+            double low = 1.0, high = 0.0, sum = 0.0;
+            for (const Variation& variation : result.variations) {
+                low = std::min(low, variation.measures.distance);
+                high = std::max(high, variation.measures.distance);
+                sum += variation.measures.distance;
+            }
+            // The closest pair among the first nine (one grid).
+            double closest = 1.0;
+            std::vector<std::vector<std::uint16_t>> grid;
+            for (std::size_t i = 0; i < std::min<std::size_t>(9, result.variations.size()); ++i)
+                grid.push_back(thumbnailOf(result.variations[i].params));
+            for (std::size_t i = 0; i < grid.size(); ++i)
+                for (std::size_t j = 0; j < i; ++j) closest = std::min(closest, thumbnailDistance(grid[i], grid[j]));
+            std::printf("%-7s %8zu", std::string(name.name).c_str(), result.variations.size());
+            for (int r = 0; r < kRejectionCount; ++r)
+                std::printf(" %*d", r == 0 || r == kRejectionCount - 1 ? 8 : 6, result.rejected[r]);
+            std::printf(" %8.3f  %.3f / %.3f / %.3f; first grid's closest pair %.3f\n", result.minimumDistance, low,
+                        result.variations.empty() ? 0.0 : sum / double(result.variations.size()), high, closest);
         }
-        // The closest pair among the first nine (one grid).
-        double closest = 1.0;
-        std::vector<std::vector<std::uint16_t>> grid;
-        for (std::size_t i = 0; i < std::min<std::size_t>(9, result.variations.size()); ++i)
-            grid.push_back(thumbnailOf(result.variations[i].params));
-        for (std::size_t i = 0; i < grid.size(); ++i)
-            for (std::size_t j = 0; j < i; ++j) closest = std::min(closest, thumbnailDistance(grid[i], grid[j]));
-        std::printf("%-7s %8zu", std::string(name.name).c_str(), result.variations.size());
-        for (int r = 0; r < kRejectionCount; ++r)
-            std::printf(" %*d", r == 0 || r == kRejectionCount - 1 ? 8 : 6, result.rejected[r]);
-        std::printf(" %8.3f  %.3f / %.3f / %.3f; first grid's closest pair %.3f\n", result.minimumDistance, low,
-                    result.variations.empty() ? 0.0 : sum / double(result.variations.size()), high, closest);
     }
     return 0;
 }
