@@ -368,7 +368,9 @@ VariationResult search(const Params& base, const std::vector<std::uint16_t>& ori
     for (int next = 0; int(result.variations.size()) < wanted && next < limit; next += kBlock) {
         const int size = std::min(kBlock, limit - next);
         std::vector<Judged> judged(size);
-        tbb::parallel_for(0, size, [&](int i) { judged[i] = judge(candidateFor(base, baseSlice, options, next + i), outsideBefore); });
+        tbb::parallel_for(0, size, [&](int i) {
+            judged[i] = judge(candidateFor(base, baseSlice, options, next + i), outsideBefore);
+        });
         for (int i = 0; i < size && int(result.variations.size()) < wanted; ++i) {
             ++result.candidates;
             Judged& candidate = judged[i];
@@ -498,9 +500,8 @@ VariationResult vary(const Params& base, const VariationOptions& options, const 
         throw ParamError("fractal",
                          "the starting document is itself empty, so there is nothing to vary: no point of "
                          "its " +
-                             std::to_string(kThumbnail) +
-                             "^3 thumbnail lattice is inside at N = " + std::to_string(base.fractal.iterations) +
-                             "; try fewer iterations or another slice");
+                             std::to_string(kThumbnail) + "^3 thumbnail lattice is inside at N = " +
+                             std::to_string(base.fractal.iterations) + "; try fewer iterations or another slice");
     const int limit = options.maxCandidates > 0 ? options.maxCandidates : 60 * options.count;
     VariationResult result = search(base, original.pixels, options, limit, options.count, progress);
     if (int(result.variations.size()) < options.count) {

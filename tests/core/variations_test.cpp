@@ -71,8 +71,8 @@ TEST(Variations, EveryVariationIsValidNonEmptyAndWithinTheMeasures) {
             const dqj::InspectReport report = dqj::inspect(again, 16);
             EXPECT_TRUE(report.emptyReason.empty()) << report.emptyReason;
             // Not dust: inside the Mandelbrot set, or still in one piece at N.
-            const bool inside = report.real.inMandelbrot &&
-                                (again.fractal.variant == dqj::Variant::Dual || report.dual.inMandelbrot);
+            const bool inside =
+                report.real.inMandelbrot && (again.fractal.variant == dqj::Variant::Dual || report.dual.inMandelbrot);
             EXPECT_TRUE(inside || variation.measures.connected >= dqj::kMinConnected);
             EXPECT_GE(variation.measures.coverage, dqj::kMinCoverage);
             EXPECT_GE(variation.measures.roughness, dqj::kMinRoughness);
