@@ -31,8 +31,9 @@
 // values (2G - depth for a hit, 0 for a miss): 1 - sum(min) / sum(max), 0 for identical
 // pictures, 1 for pictures that share no pixel.
 //
-// Cost: a candidate is one inspect() at 16^3 and kThumbnail^3 = 40^3 evaluations (about 2 ms on
-// one core at N = 15); candidates are measured in parallel, accepted in their order.
+// Cost: a candidate is one inspect() at 16^3, kThumbnail^3 = 40^3 evaluations and a flood fill
+// of the lattice (a few ms on one core at N = 15); candidates are measured in parallel, in
+// blocks of 8, and accepted in their order.
 #pragma once
 
 #include <array>
