@@ -28,6 +28,7 @@ ALLOWED = {
     "render": {"platform", "files", "params", "kernel"},  # the renderer, images, POV-Ray scenes
     "bake": {"platform", "files", "params", "kernel"},  # bakes, level sets, meshes, attribute grids
     "tiles": {"platform", "files", "params", "kernel", "bake"},  # tiled bakes and their merge
+    "explore": {"platform", "files", "params", "kernel"},  # variations around a document
 }
 TOP = ""  # core/src itself: c_api.cpp, over everything
 ALLOWED[TOP] = set(ALLOWED)

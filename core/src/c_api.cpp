@@ -16,6 +16,8 @@
 #include <system_error>
 #include <unordered_map>
 
+#include <nlohmann/json.hpp>
+
 #include "dqjulia/bake.hpp"
 #include "dqjulia/image.hpp"
 #include "dqjulia/empty_result.hpp"
@@ -23,6 +25,7 @@
 #include "dqjulia/mesh.hpp"
 #include "dqjulia/params.hpp"
 #include "dqjulia/render.hpp"
+#include "dqjulia/variations.hpp"
 #include "files/message_text.hpp"
 
 struct dqj_context_t {
@@ -33,6 +36,7 @@ struct dqj_context_t {
     std::uint64_t memoryLimit = 0;  // 0 = dqj::defaultMemoryLimit()
     dqj::Mesh mesh;                 // from the last dqj_mesh_compute
     dqj::BakeStats bakeStats;       // of the last bake or mesh
+    dqj::VariationResult variations;  // from the last dqj_variations_compute
 };
 
 namespace {
@@ -236,7 +240,7 @@ const char* dqj_status_string(dqj_status status) {
 int dqj_has_feature(const char* name) {
     if (!name) return 0;
     // Every build has them today; the names are for builds and hosts that may not.
-    for (const char* feature : {DQJ_FEATURE_VDB, DQJ_FEATURE_MESH, DQJ_FEATURE_ANIMATION})
+    for (const char* feature : {DQJ_FEATURE_VDB, DQJ_FEATURE_MESH, DQJ_FEATURE_ANIMATION, DQJ_FEATURE_VARIATIONS})
         if (std::strcmp(name, feature) == 0) return 1;
     return 0;
 }
@@ -591,6 +595,64 @@ dqj_status dqj_bake_get_stats(dqj_context context, dqj_bake_stats* outStats) {
         stats.struct_size = std::min(given, sizeof stats);  // an older library fills less than a newer caller's size
         std::memcpy(outStats, &stats, stats.struct_size);
         return DQJ_OK;
+    });
+}
+
+dqj_status dqj_variations_compute(dqj_context context, uint64_t seed, double strength, uint32_t lockedGroups,
+                                  uint32_t count, dqj_progress_fn progress, void* userData) {
+    static_assert(DQJ_GROUP_A == dqj::kGroupA && DQJ_GROUP_B == dqj::kGroupB &&
+                  DQJ_GROUP_SLICE_ORIENTATION == dqj::kGroupSliceOrientation &&
+                  DQJ_GROUP_SLICE_ORIGIN == dqj::kGroupSliceOrigin && DQJ_GROUP_ITERATIONS == dqj::kGroupIterations &&
+                  DQJ_GROUP_VARIANT == dqj::kGroupVariant && DQJ_GROUP_ALL == dqj::kAllVariationGroups);
+    return guarded(context, [&](dqj_context_t& self) {
+        if (!(strength >= dqj::kMinStrength && strength <= dqj::kMaxStrength))
+            return invalidArgument(self,
+                                   "strength must be from 0.01 to 1 (DQJ_STRENGTH_TINY 0.05 ... DQJ_STRENGTH_HUGE 1)");
+        if (count < 1 || count > 100) return invalidArgument(self, "count must be from 1 to 100");
+        if (lockedGroups & ~DQJ_GROUP_ALL)
+            return invalidArgument(self, "locked_groups has bits other than DQJ_GROUP_*");
+        if (lockedGroups == DQJ_GROUP_ALL)
+            return invalidArgument(self, "every group is locked: nothing may change; unlock at least one DQJ_GROUP_*");
+        dqj::VariationOptions options;
+        options.seed = seed;
+        options.strength = strength;
+        options.locked = lockedGroups;
+        options.count = int(count);
+        self.variations =
+            dqj::vary(dqj::stillAtFrame(paramsNow(self), self.frame), options, wrapProgress(progress, userData));
+        return DQJ_OK;
+    });
+}
+
+dqj_status dqj_variations_get_json(dqj_context context, char* buffer, size_t capacity, size_t* outSize) {
+    return guarded(context, [&](dqj_context_t& self) {
+        const dqj::VariationResult& result = self.variations;
+        nlohmann::ordered_json document;
+        document["count"] = result.variations.size();
+        document["candidates"] = result.candidates;
+        for (int r = 0; r < dqj::kRejectionCount; ++r)
+            document["rejected"][std::string(dqj::rejectionName(dqj::Rejection(r)))] = result.rejected[r];
+        document["minimum_distance"] = result.minimumDistance;
+        document["variations"] = nlohmann::ordered_json::array();
+        for (const dqj::Variation& variation : result.variations)
+            document["variations"].push_back({{"candidate", variation.candidate},
+                                              {"coverage", variation.measures.coverage},
+                                              {"roughness", variation.measures.roughness},
+                                              {"distance", variation.measures.distance},
+                                              {"connected", variation.measures.connected},
+                                              {"description", variation.params.description}});
+        return copyText(self, document.dump(2) + "\n", buffer, capacity, outSize);
+    });
+}
+
+dqj_status dqj_variation_get_params_json(dqj_context context, size_t index, char* buffer, size_t capacity,
+                                         size_t* outSize) {
+    return guarded(context, [&](dqj_context_t& self) {
+        const std::vector<dqj::Variation>& variations = self.variations.variations;
+        if (index >= variations.size())
+            return invalidArgument(self, "index " + std::to_string(index) + " is out of range: the context has " +
+                                             std::to_string(variations.size()) + " variations");
+        return copyText(self, dqj::toJson(variations[index].params), buffer, capacity, outSize);
     });
 }
 

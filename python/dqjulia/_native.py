@@ -103,7 +103,27 @@ VARIANTS = ("paper", "paper-coupled", "dual")  # dqj_variant order
 FEATURE_VDB = "vdb"
 FEATURE_MESH = "mesh"
 FEATURE_ANIMATION = "animation"
-FEATURES = (FEATURE_VDB, FEATURE_MESH, FEATURE_ANIMATION)
+FEATURE_VARIATIONS = "variations"
+FEATURES = (FEATURE_VDB, FEATURE_MESH, FEATURE_ANIMATION, FEATURE_VARIATIONS)
+
+# The groups a variation may change (DQJ_GROUP_*), by the names `dqjulia explore --lock` takes.
+GROUP_A = 0x01
+GROUP_B = 0x02
+GROUP_SLICE_ORIENTATION = 0x04
+GROUP_SLICE_ORIGIN = 0x08
+GROUP_ITERATIONS = 0x10
+GROUP_VARIANT = 0x20
+GROUP_ALL = 0x3F
+GROUPS: Dict[str, int] = {
+    "a": GROUP_A,
+    "b": GROUP_B,
+    "orientation": GROUP_SLICE_ORIENTATION,
+    "origin": GROUP_SLICE_ORIGIN,
+    "iterations": GROUP_ITERATIONS,
+    "variant": GROUP_VARIANT,
+}
+# The named strengths (DQJ_STRENGTH_*), tiny to huge.
+STRENGTHS: Dict[str, float] = {"tiny": 0.05, "small": 0.15, "medium": 0.3, "large": 0.6, "huge": 1.0}
 
 
 class DqjuliaError(RuntimeError):
@@ -296,6 +316,21 @@ _SIGNATURES: Dict[str, Tuple[Any, List[Any], Optional[Tuple[str, ...]]]] = {
     ),
     "dqj_mesh_write": (_status, [_handle, ctypes.c_char_p], (FEATURE_MESH,)),
     "dqj_bake_get_stats": (_status, [_handle, ctypes.POINTER(BakeStats)], _BAKE),
+    "dqj_variations_compute": (
+        _status,
+        [_handle, ctypes.c_uint64, ctypes.c_double, ctypes.c_uint32, ctypes.c_uint32, PROGRESS_FN, ctypes.c_void_p],
+        (FEATURE_VARIATIONS,),
+    ),
+    "dqj_variations_get_json": (
+        _status,
+        [_handle, ctypes.c_void_p, ctypes.c_size_t, _size_p],
+        (FEATURE_VARIATIONS,),
+    ),
+    "dqj_variation_get_params_json": (
+        _status,
+        [_handle, ctypes.c_size_t, ctypes.c_void_p, ctypes.c_size_t, _size_p],
+        (FEATURE_VARIATIONS,),
+    ),
 }
 
 _lock = threading.Lock()
@@ -639,6 +674,14 @@ class Context:
         self.check(function(self.handle, buffer, size.value, ctypes.byref(size)), function_name)
         return buffer.value.decode("utf-8")
 
+    def _indexed_text_out(self, function_name: str, index: int) -> str:
+        function = _function(function_name)
+        size = ctypes.c_size_t(0)
+        self.check(function(self.handle, index, None, 0, ctypes.byref(size)), function_name)
+        buffer = ctypes.create_string_buffer(size.value)
+        self.check(function(self.handle, index, buffer, size.value, ctypes.byref(size)), function_name)
+        return buffer.value.decode("utf-8")
+
     def _run(self, what: str, function: Callable[..., int], progress: Optional[Progress], *arguments: Any) -> str:
         """A call that reports progress: `function(handle, *arguments, callback, None)`. An error
         kept by the callback (an exception in on_progress, Ctrl-C) is raised in place of the
@@ -805,3 +848,39 @@ class Context:
         stats = BakeStats(struct_size=ctypes.sizeof(BakeStats))
         self.check(_function("dqj_bake_get_stats")(self.handle, ctypes.byref(stats)), "bake stats")
         return stats
+
+    # Variations -------------------------------------------------------------------------
+
+    def variations_compute(
+        self,
+        seed: int,
+        strength: float = STRENGTHS["medium"],
+        locked_groups: int = GROUP_VARIANT,
+        count: int = 9,
+        progress: Optional[Progress] = None,
+    ) -> str:
+        """Computes `count` variations of the context's parameters (feature "variations") and
+        keeps them in the context. `locked_groups`: GROUP_* bits that stay as they are. Raises
+        InvalidArgumentError for a bad strength, count or lock, ParameterError for an empty start
+        or when too few pass (the message says how to loosen the settings)."""
+        return self._run(
+            "variations",
+            _function("dqj_variations_compute"),
+            progress,
+            ctypes.c_uint64(int(seed) & 0xFFFFFFFFFFFFFFFF),
+            float(strength),
+            int(locked_groups),
+            int(count),
+        )
+
+    def variations(self) -> Dict[str, Any]:
+        """dqj_variations_get_json as a dict: the candidates, the rejections by measure and each
+        variation's measures and description."""
+        return _json_object(self._text_out("dqj_variations_get_json"))
+
+    def variation_params_json(self, index: int) -> str:
+        """Variation `index` as a complete parameter document (JSON text), for set_params_json."""
+        return self._indexed_text_out("dqj_variation_get_params_json", int(index))
+
+    def variation_params(self, index: int) -> Dict[str, Any]:
+        return _json_object(self.variation_params_json(index))

@@ -251,6 +251,55 @@ static void test_empty_slice(dqj_context context) {
           dqj_context_warning(context));
 }
 
+/* Variations: the same seed gives the same documents, each a complete document the context
+ * takes back; bad settings and an empty start get a status and a message. */
+static void test_variations(dqj_context context) {
+    char first[16384], again[16384], report[8192];
+    size_t needed = 0;
+    int calls = 0;
+    CHECK(dqj_has_feature(DQJ_FEATURE_VARIATIONS) == 1, "no feature variations");
+    CHECK(dqj_context_set_params_json(context, "{}") == DQJ_OK, "defaults: %s", dqj_context_error(context));
+    CHECK(dqj_variations_get_json(context, report, sizeof report, NULL) == DQJ_OK &&
+              strstr(report, "\"count\": 0") != NULL,
+          "before any: %s", report);
+    CHECK(dqj_variations_compute(context, 7, DQJ_STRENGTH_MEDIUM, DQJ_GROUP_VARIANT, 3, count_calls, &calls) == DQJ_OK,
+          "compute: %s", dqj_context_error(context));
+    CHECK(calls >= 2, "progress called %d times", calls);
+    CHECK(dqj_variation_get_params_json(context, 2, NULL, 0, &needed) == DQJ_OK && needed > 100, "size %zu", needed);
+    CHECK(dqj_variation_get_params_json(context, 0, first, sizeof first, NULL) == DQJ_OK, "get: %s",
+          dqj_context_error(context));
+    CHECK(strstr(first, "Variation 1 (seed 7") != NULL, "description: %.200s", first);
+    CHECK(dqj_variation_get_params_json(context, 3, first, sizeof first, NULL) == DQJ_ERROR_INVALID_ARGUMENT &&
+              strstr(dqj_context_error(context), "out of range") != NULL,
+          "index 3 of 3: %s", dqj_context_error(context));
+    CHECK(dqj_variations_get_json(context, report, sizeof report, NULL) == DQJ_OK &&
+              strstr(report, "\"count\": 3") != NULL && strstr(report, "\"similar\"") != NULL,
+          "report: %s", report);
+    CHECK(dqj_variation_get_params_json(context, 0, first, sizeof first, NULL) == DQJ_OK, "get again");
+    CHECK(dqj_variations_compute(context, 7, DQJ_STRENGTH_MEDIUM, DQJ_GROUP_VARIANT, 3, NULL, NULL) == DQJ_OK,
+          "compute again: %s", dqj_context_error(context));
+    CHECK(dqj_variation_get_params_json(context, 0, again, sizeof again, NULL) == DQJ_OK && strcmp(first, again) == 0,
+          "the same seed gave another document");
+    /* A variation is a complete document the context takes as it is. */
+    CHECK(dqj_context_set_params_json(context, first) == DQJ_OK, "set variation: %s", dqj_context_error(context));
+    CHECK(dqj_context_get_params_json(context, again, sizeof again, NULL) == DQJ_OK && strcmp(first, again) == 0,
+          "the variation changed on the way back");
+    /* Bad settings: a status and a message; the variations of the last success are kept. */
+    CHECK(dqj_variations_compute(context, 1, 1.5, 0, 3, NULL, NULL) == DQJ_ERROR_INVALID_ARGUMENT &&
+              strstr(dqj_context_error(context), "strength") != NULL,
+          "strength 1.5: %s", dqj_context_error(context));
+    CHECK(dqj_variations_compute(context, 1, 0.3, DQJ_GROUP_ALL, 3, NULL, NULL) == DQJ_ERROR_INVALID_ARGUMENT &&
+              strstr(dqj_context_error(context), "every group is locked") != NULL,
+          "all locked: %s", dqj_context_error(context));
+    CHECK(dqj_variations_compute(context, 1, 0.3, 0, 0, NULL, NULL) == DQJ_ERROR_INVALID_ARGUMENT, "count 0");
+    CHECK(dqj_variations_compute(context, 1, 0.3, 0, 3, cancel_at_once, NULL) == DQJ_ERROR_CANCELLED, "cancel");
+    CHECK(dqj_variation_get_params_json(context, 2, NULL, 0, &needed) == DQJ_OK, "kept after failures");
+    CHECK(dqj_context_set_params_json(context, c1_paper) == DQJ_OK, "params: %s", dqj_context_error(context));
+    CHECK(dqj_variations_compute(context, 1, 0.3, 0, 3, NULL, NULL) == DQJ_ERROR_PARAMETERS &&
+              strstr(dqj_context_error(context), "itself empty") != NULL,
+          "empty start: %s", dqj_context_error(context));
+}
+
 #ifdef _WIN32
 #define SEPARATOR '\\'
 /* Windows opens a UTF-8 name by its UTF-16 form. */
@@ -343,6 +392,7 @@ int main(int argc, char** argv) {
     test_render(context, scratch);
     test_empty_slice(context);
     test_bake_stats(context);
+    test_variations(context);
     test_paths(context, scratch);
     dqj_context_destroy(context);
     printf("%d passed, %d failed\n", checks - failures, failures);

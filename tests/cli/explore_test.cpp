@@ -6,6 +6,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <bit>
+#include <cstdint>
 #include <sstream>
 
 #include "contact_sheet.hpp"
@@ -63,6 +65,90 @@ TEST(Explore, SameSeedSameConstantsAndEveryTileIsNonEmpty) {
     EXPECT_EQ(sheet.width, 8 + 2 * (64 + 8));
     EXPECT_EQ(runCli("explore -q --seed 11 --count 1 -o '" + first.string() + "'"), 2);
     for (const fs::path& dir : {first, second, other}) fs::remove_all(dir);
+}
+
+/// A parameter file in `dir` (made) with `json`.
+fs::path writeParams(const fs::path& dir, const std::string& json) {
+    fs::create_directories(dir);
+    fs::path path = dir / "start.json";
+    std::ofstream(path) << json;
+    return path;
+}
+
+TEST(ExploreAround, WritesTheSheetAndEveryTilesCompleteDocumentTheSameForTheSameSeed) {
+    const fs::path input = scratch("around_input");
+    const fs::path start = writeParams(input, R"({"description": "start", "render": {"width": 320, "height": 200}})");
+    const fs::path first = scratch("around_first"), second = scratch("around_second");
+    const std::string arguments = "explore -q --around '" + start.string() +
+                                  "' --seed 4 --strength small --lock a,variant --tile-width 40 --tile-height 32 -o '";
+    ASSERT_EQ(runCli(arguments + first.string() + "'"), 0);
+    ASSERT_EQ(runCli(arguments + second.string() + "'"), 0);
+    const dqj::Params original = dqj::loadParams(start.string());
+    for (int tile = 1; tile <= 9; ++tile) {  // a 3 x 3 grid by default
+        const std::string name = "tile_0" + std::to_string(tile);
+        const dqj::Params params = dqj::parseParams(readFile(first / (name + ".json")), name);
+        dqj::Params again = dqj::parseParams(readFile(second / (name + ".json")), name);
+        again.output.path = params.output.path;  // the folders differ
+        EXPECT_EQ(dqj::toJson(params), dqj::toJson(again)) << name;
+        // A complete, valid, non-empty document at the original's size, its own picture's name
+        // beside the tile, the locked part as it was.
+        EXPECT_TRUE(dqj::inspect(params, 16).emptyReason.empty()) << name;
+        EXPECT_EQ(params.render.width, 320);
+        EXPECT_EQ(params.output.path, (first / (name + "_render.png")).string());
+        for (int k = 0; k < 4; ++k)  // bit for bit
+            EXPECT_EQ(std::bit_cast<std::uint64_t>(dqj::component(params.fractal.c.a, k)),
+                      std::bit_cast<std::uint64_t>(dqj::component(original.fractal.c.a, k)))
+                << name;
+        EXPECT_NE(params.description.find("Variation " + std::to_string(tile) + " (seed 4, strength small"),
+                  std::string::npos)
+            << params.description;
+        EXPECT_EQ(dqj::readPng(first / (name + ".png")).width, 40);
+    }
+    EXPECT_FALSE(fs::exists(first / "tile_10.json"));
+    EXPECT_EQ(dqj::readPng((first / "sheet.png").string()).width, 8 + 3 * (40 + 8));
+    // A pick goes straight on: rendered as it is (here smaller), and varied again.
+    EXPECT_EQ(runCli("render -q -p '" + (first / "tile_05.json").string() + "' -W 32 -H 24"), 0);
+    EXPECT_EQ(dqj::readPng(first / "tile_05_render.png").width, 32);
+    const fs::path third = scratch("around_third");
+    EXPECT_EQ(runCli("explore -q --around '" + (first / "tile_05.json").string() +
+                     "' --count 2 --tile-width 24 --tile-height 24 -o '" + third.string() + "'"),
+              0);
+    EXPECT_EQ(dqj::loadParams((third / "tile_01.json").string()).description.rfind("Variation 1 (seed 1", 0), 0u);
+    for (const fs::path& dir : {input, first, second, third}) fs::remove_all(dir);
+}
+
+TEST(ExploreAround, BadSettingsAndAnEmptyStartExitTwoAndWriteNothing) {
+    const fs::path input = scratch("around_bad");
+    const fs::path start = writeParams(input, "{}");
+    const fs::path empty = input / "empty.json";
+    std::ofstream(empty) << R"({"fractal": {"c": [-0.10, 0.8, -0.26, 0.15, -0.23, -0.38, -0.86, 0.64]}})";
+    const fs::path out = input / "out";
+    const std::string around = "explore -q --around '" + start.string() + "' -o '" + out.string() + "' ";
+    for (const std::string& bad : {around + "--strength 1.5", around + "--strength enormous", around + "--strength 0",
+                                   around + "--lock a,b,slice,iterations,variant", around + "--lock colour",
+                                   "explore -q --strength tiny -o '" + out.string() + "'",
+                                   "explore -q --around '" + empty.string() + "' -o '" + out.string() + "'",
+                                   around + "--params '" + start.string() + "'"}) {
+        EXPECT_EQ(runCli(bad), 2) << bad;
+        EXPECT_FALSE(fs::exists(out)) << bad;
+    }
+    // The messages say what to do.
+    const std::string log = (input / "log.txt").string();
+    std::system(("'" + std::string(DQJ_CLI) + "' explore -q --around '" + empty.string() + "' -o '" + out.string() +
+                 "' 2> '" + log + "'")
+                    .c_str());
+    EXPECT_NE(readFile(log).find("starting document is itself empty"), std::string::npos) << readFile(log);
+    std::system(("'" + std::string(DQJ_CLI) + "' " + around + "--strength 3 2> '" + log + "'").c_str());
+    EXPECT_NE(readFile(log).find("out of range: give 0.01 to 1 or tiny"), std::string::npos) << readFile(log);
+    // An existing sheet is refused before the work, without --force; nothing else is written.
+    fs::create_directories(out);
+    std::ofstream(out / "sheet.png") << "mine";
+    EXPECT_EQ(runCli(around + "--count 2"), 2);
+    EXPECT_EQ(readFile(out / "sheet.png"), "mine");
+    EXPECT_FALSE(fs::exists(out / "tile_01.json"));
+    EXPECT_EQ(runCli(around + "--count 2 --tile-width 16 --tile-height 16 --force"), 0);
+    EXPECT_TRUE(fs::exists(out / "tile_02.json"));
+    fs::remove_all(input);
 }
 
 TEST(ContactSheet, LaysOutTilesAndDrawsLabels) {

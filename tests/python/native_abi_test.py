@@ -67,6 +67,12 @@ def main():
     for name, value in features.items():
         checks["feature %s = %r" % (name, value)] = getattr(native, "FEATURE_" + name, None) == value
 
+    groups = dict(re.findall(r"#define\s+DQJ_GROUP_(\w+)\s+(0x[0-9a-f]+)u", header))
+    for name, value in groups.items():
+        checks["group %s = %s" % (name, value)] = getattr(native, "GROUP_" + name, None) == int(value, 16)
+    strengths = dict(re.findall(r"#define\s+DQJ_STRENGTH_(\w+)\s+([0-9.]+)", header))
+    checks["strengths %s" % strengths] = {k.lower(): float(v) for k, v in strengths.items()} == native.STRENGTHS
+
     structs = (("dqj_sample", native.Sample), ("dqj_bake_stats", native.BakeStats))
     for struct, cls in structs:
         body = re.search(r"typedef struct %s \{(.*?)\} %s;" % (struct, struct), header, re.S).group(1)

@@ -83,6 +83,8 @@ const InputCase kInputCases[] = {
     {"povray_include", "p.json", "dqjulia.inc", "povray -q -p DIR/p.json -o DIR/scene.pov"},
     {"explore_tile", "explore/tile_01.json", "explore/tile_01.json",
      "explore -q --count 2 --tile-width 16 --tile-height 16 -p DIR/explore/tile_01.json -o DIR/explore"},
+    {"explore_around", "explore/tile_01.json", "explore/tile_01.json",
+     "explore -q --count 2 --tile-width 16 --tile-height 16 --around DIR/explore/tile_01.json -o DIR/explore"},
     {"sheet", "pic.png", "pic.png", "sheet -t DIR/pic.png -o DIR/pic.png"},
     {"bake", "p.json", "out.vdb", "bake -q -r 8 -p DIR/p.json -o DIR/out.vdb"},
     {"bake_frame", "p.json", "seq_0002.vdb", "bake -q -r 8 -p DIR/p.json --frames 1-3 -o DIR/seq.vdb"},

@@ -4,7 +4,7 @@ compare_outputs (its PNG reader, the Linux OpenVDB); every output named with a d
 backslashes, in a folder with spaces and letters beyond ASCII; an existing output kept without
 --force and replaced with it; no temporary file left behind; names Windows cannot hold (CON, NUL,
 COM1, a trailing dot, a stream) refused before the work; an input never an output; a multi-file
-run replaced all together.
+run replaced all together; `explore --around` giving the same documents as on Linux for a seed.
 
 Usage: python3 cli_test.py WORK LINUX_BUILD DQJULIA_EXE EMULATOR...
 """
@@ -79,7 +79,39 @@ def main():
         name for name, _, _ in OUTPUTS
     )
     checks.update(check_outputs(work, exe, emulator))
+    checks.update(check_variations(work, linux_cli, exe, emulator))
     return report(checks)
+
+
+def check_variations(work, linux_cli, exe, emulator):
+    """`explore --around` with the same seed gives the same parameter documents, byte for byte
+    but for the output path (the folder's name), on Linux and Windows (issue 38)."""
+    checks = {}
+    start = os.path.join(work, "start.json")
+    with open(start, "w") as file:
+        file.write('{"description": "start", "fractal": {"iterations": 12}}\n')
+    folders = {"Linux": os.path.join(work, "around linux"), "Windows": os.path.join(work, "around windows")}
+    settings = ["explore", "-q", "--seed", "5", "--strength", "large", "--lock", "variant", "--count", "4"]
+    settings += ["--tile-width", "24", "--tile-height", "24"]
+    for system, command in (("Linux", [linux_cli]), ("Windows", [*emulator, exe])):
+        around = start if system == "Linux" else windows_path(start)
+        folder = folders[system] if system == "Linux" else windows_path(folders[system])
+        status, output = run([*command, *settings, "--around", around, "-o", folder])
+        checks["%s explore --around: exit %d %s" % (system, status, output.strip())] = status == 0
+    for tile in range(1, 5):
+        documents = []
+        for folder in folders.values():
+            try:
+                with open(os.path.join(folder, "tile_%02d.json" % tile), "rb") as file:
+                    lines = file.read().split(b"\n")
+            except OSError:
+                lines = None
+            # Byte for byte but for output.path's line: the folders differ.
+            documents.append(lines and [line for line in lines if not line.lstrip().startswith(b'"path"')])
+        checks["explore --around tile %d byte for byte the same on Linux and Windows" % tile] = (
+            documents[0] is not None and documents[0] == documents[1]
+        )
+    return checks
 
 
 # Names Windows cannot hold, as a file or as a folder on the way: each refused before the work.

@@ -35,7 +35,7 @@
  * Separate contexts are independent and may be used from different threads at the same
  * time. One context is used by one call at a time (a second call meanwhile is refused with
  * DQJ_ERROR_BUSY, not queued); its progress callback runs on the thread that called dqj_render*(),
- * dqj_bake_vdb() or dqj_mesh_compute().
+ * dqj_bake_vdb(), dqj_mesh_compute() or dqj_variations_compute().
  */
 #ifndef DQJULIA_H
 #define DQJULIA_H
@@ -85,6 +85,8 @@ DQJ_API int dqj_has_feature(const char* name);
 #define DQJ_FEATURE_MESH "mesh"
 /* keyframes (the parameters' "animation") and dqj_context_set_frame */
 #define DQJ_FEATURE_ANIMATION "animation"
+/* dqj_variations_compute, dqj_variations_get_json, dqj_variation_get_params_json (since 1.1) */
+#define DQJ_FEATURE_VARIATIONS "variations"
 
 typedef enum dqj_variant {
     DQJ_VARIANT_PAPER = 0,         /* the paper's rule: a and b iterate independently */
@@ -239,6 +241,50 @@ typedef struct dqj_bake_stats {
 #define DQJ_BAKE_STATS_INIT \
     { .struct_size = sizeof(dqj_bake_stats) }
 DQJ_API dqj_status dqj_bake_get_stats(dqj_context context, dqj_bake_stats* out_stats);
+
+/* ---- Variations: the fractal next to the one in front of you (README "Exploring") ---------------
+ * Variations of the context's parameters (at its frame, as a still: without "animation"): each
+ * proven non-empty and not dust by the library's own analysis, neither a featureless ball nor
+ * too small in the frame, no two nearly the same picture, all of them further from the original
+ * as the strength grows. The same seed, strength, locks and count give the same documents on
+ * every platform. Feature DQJ_FEATURE_VARIATIONS. */
+
+/* Groups of values a variation may change; the locked ones stay as they are, bit for bit. */
+#define DQJ_GROUP_A 0x01u                 /* fractal.c's real part a */
+#define DQJ_GROUP_B 0x02u                 /* fractal.c's dual part b */
+#define DQJ_GROUP_SLICE_ORIENTATION 0x04u /* slice.rotations */
+#define DQJ_GROUP_SLICE_ORIGIN 0x08u      /* slice.origin */
+#define DQJ_GROUP_ITERATIONS 0x10u        /* fractal.iterations and fractal.bailout */
+#define DQJ_GROUP_VARIANT 0x20u           /* fractal.variant (switched only at large strengths) */
+#define DQJ_GROUP_ALL 0x3fu
+
+/* Strengths from 0.01 to 1, named as an artist would (Mandelbulber's Randomizer): */
+#define DQJ_STRENGTH_TINY 0.05  /* the same fractal with its details moved a little */
+#define DQJ_STRENGTH_SMALL 0.15 /* a close relative: the same overall form, different details */
+#define DQJ_STRENGTH_MEDIUM 0.3 /* a sibling: recognisably related, noticeably different */
+#define DQJ_STRENGTH_LARGE 0.6  /* a cousin: a different form from the same neighbourhood */
+#define DQJ_STRENGTH_HUGE 1.0   /* a stranger: anything the unlocked groups can reach */
+
+/* Computes `count` (1..100) variations and keeps them in the context, replacing the previous
+ * ones (which are kept if this call fails). `locked_groups`: DQJ_GROUP_* bits that stay; at
+ * least one group must be open. Progress as for renders (0 cancels). Fails with
+ * DQJ_ERROR_INVALID_ARGUMENT for a strength, count or lock out of range, and with
+ * DQJ_ERROR_PARAMETERS when the context's document is itself empty (or dust in a locked part),
+ * or when fewer than `count` variations pass within 60 * count candidates: the message says
+ * which measures rejected how many and how to loosen the settings (raise the strength, unlock
+ * groups). Never fewer variations than asked for on success. */
+DQJ_API dqj_status dqj_variations_compute(dqj_context context, uint64_t seed, double strength, uint32_t locked_groups,
+                                          uint32_t count, dqj_progress_fn progress, void* user_data);
+/* The context's variations as JSON: {"count", "candidates", "rejected": {"invalid", "empty",
+ * "dust", "tiny", "ball", "similar"}, "minimum_distance", "variations": [{"candidate",
+ * "coverage", "roughness", "distance", "connected", "description"}, ...]} (count 0 before the first
+ * dqj_variations_compute). Same buffer convention as dqj_context_get_params_json. */
+DQJ_API dqj_status dqj_variations_get_json(dqj_context context, char* buffer, size_t capacity, size_t* out_size);
+/* Variation `index` (0-based) as a complete parameter document, exactly as
+ * dqj_context_get_params_json would give it after dqj_context_set_params_json with it. Same
+ * buffer convention; an index out of range gives DQJ_ERROR_INVALID_ARGUMENT. */
+DQJ_API dqj_status dqj_variation_get_params_json(dqj_context context, size_t index, char* buffer, size_t capacity,
+                                                 size_t* out_size);
 
 #ifdef __cplusplus
 }
