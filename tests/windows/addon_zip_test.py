@@ -53,8 +53,17 @@ class FakeDll:
 
 def load_on_windows(native_path):
     """native.py's _load() as on Windows: which folder it adds and which file it loads."""
-    spec = importlib.util.spec_from_file_location("dqjulia_native_windows", native_path)
+    # As a module of its own package (a stand-in named after its folder), so that it finds the
+    # _buildinfo.py beside it as Blender's and pip's imports do.
+    folder = os.path.dirname(os.path.abspath(native_path))
+    package_name = "dqjulia_windows_%d" % len(sys.modules)
+    package = types.ModuleType(package_name)
+    package.__path__ = [folder]
+    sys.modules[package_name] = package
+    name = "%s.%s" % (package_name, os.path.splitext(os.path.basename(native_path))[0])
+    spec = importlib.util.spec_from_file_location(name, native_path)
     native = importlib.util.module_from_spec(spec)
+    sys.modules[name] = native
     spec.loader.exec_module(native)
     added, loaded = [], []
     native.sys = types.SimpleNamespace(platform="win32")
