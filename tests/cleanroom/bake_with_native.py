@@ -6,24 +6,18 @@ Usage: python3 bake_with_native.py ADDON_DIR WORK_DIR [RESOLUTION]
 ADDON_DIR is the add-on's package folder from the zip (dqjulia/, holding native.py and lib/).
 """
 
-import importlib.util
 import json
 import os
 import sys
-import types
+
+
+sys.path.append(os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "common"))
+from package_module import load_package_module  # noqa: E402 (beside this script in a root; tests/common here)
 
 
 def load_native(addon_dir):
-    # native.py as a module of a stand-in package over the add-on's folder, so that it finds its
-    # _buildinfo.py (the version it was built for) as in Blender; the add-on's __init__ needs bpy.
-    package = types.ModuleType("dqjulia_addon")
-    package.__path__ = [addon_dir]
-    sys.modules["dqjulia_addon"] = package
-    spec = importlib.util.spec_from_file_location("dqjulia_addon.native", os.path.join(addon_dir, "native.py"))
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["dqjulia_addon.native"] = module
-    spec.loader.exec_module(module)
-    return module
+    # As in Blender: native.py finds its _buildinfo.py (the version it was built for) beside it.
+    return load_package_module(os.path.join(addon_dir, "native.py"), "dqjulia_addon")
 
 
 def main():

@@ -59,6 +59,7 @@ def main():
             archive.extractall(here)
         os.chmod(os.path.join(here, "dqjulia", "lib", "libdqjulia.so"), 0o755)
         shutil.copy(os.path.join(HERE, "bake_with_native.py"), here)
+        shutil.copy(os.path.join(HERE, "..", "common", "package_module.py"), here)
         clean = bake(
             ["/usr/bin/python3", inside + "/bake_with_native.py", inside + "/dqjulia", inside + "/work"], root=root
         )

@@ -11,7 +11,6 @@ search path (os.add_dll_directory) before loading it, and binds every function t
 Usage: python3 addon_zip_test.py WINDOWS_ZIP LINUX_ZIP WORK
 """
 
-import importlib.util
 import json
 import os
 import re
@@ -22,6 +21,7 @@ import zipfile
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "common"))
 from check_report import report, skip_or_fail  # noqa: E402 (tests/common/check_report.py)
+from package_module import load_package_module  # noqa: E402 (tests/common/package_module.py)
 
 
 def platforms(archive):
@@ -53,18 +53,9 @@ class FakeDll:
 
 def load_on_windows(native_path):
     """native.py's _load() as on Windows: which folder it adds and which file it loads."""
-    # As a module of its own package (a stand-in named after its folder), so that it finds the
-    # _buildinfo.py beside it as Blender's and pip's imports do.
-    folder = os.path.dirname(os.path.abspath(native_path))
-    package_name = "dqjulia_windows_%d" % len(sys.modules)
-    package = types.ModuleType(package_name)
-    package.__path__ = [folder]
-    sys.modules[package_name] = package
-    name = "%s.%s" % (package_name, os.path.splitext(os.path.basename(native_path))[0])
-    spec = importlib.util.spec_from_file_location(name, native_path)
-    native = importlib.util.module_from_spec(spec)
-    sys.modules[name] = native
-    spec.loader.exec_module(native)
+    # In a stand-in package named after nothing else loaded, so that it finds the _buildinfo.py
+    # beside it as Blender's and pip's imports do.
+    native = load_package_module(native_path, "dqjulia_windows_%d" % len(sys.modules))
     added, loaded = [], []
     native.sys = types.SimpleNamespace(platform="win32")
     native.os = types.SimpleNamespace(path=os.path, environ={}, add_dll_directory=added.append)
