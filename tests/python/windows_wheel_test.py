@@ -8,7 +8,6 @@ build's (compare_outputs); its _native.py, told it runs on Windows, loads dqjuli
 Usage: python3 windows_wheel_test.py SOURCE WINDOWS_BUILD LINUX_BUILD TWINE WORK EMULATOR...
 """
 
-import importlib.util
 import os
 import shutil
 import signal
@@ -22,6 +21,7 @@ sys.path.insert(0, os.path.join(os.path.dirname(HERE), "common"))
 sys.path.insert(0, os.path.join(os.path.dirname(HERE), "windows"))
 from addon_zip_test import load_on_windows  # noqa: E402 (tests/windows: native.py's loading as on Windows)
 from check_report import report, skip_or_fail  # noqa: E402 (tests/common/check_report.py)
+from package_module import load_package_module  # noqa: E402 (tests/common/package_module.py)
 from wheel_support import check_wheel  # noqa: E402
 
 PLATFORM = "win_amd64"
@@ -33,25 +33,9 @@ def windows_path(path):
 
 
 def load_cli(package):
-    """The wheel's dqjulia._cli as on Windows: os.name "nt" (its _native from the same folder)."""
-    spec = importlib.util.spec_from_file_location(
-        "dqjulia_windows", os.path.join(package, "__init__.py"), submodule_search_locations=[package]
-    )
-    # The package's modules without running its __init__ (which would load nothing on Linux
-    # anyway): _native and _cli by file, _cli's `from . import _native` answered from sys.modules.
-    parent = importlib.util.module_from_spec(spec)
-    sys.modules["dqjulia_windows"] = parent
-    modules = {}
-    for name in ("_buildinfo", "_native", "_cli"):
-        module_spec = importlib.util.spec_from_file_location(
-            "dqjulia_windows." + name, os.path.join(package, name + ".py")
-        )
-        module = importlib.util.module_from_spec(module_spec)
-        sys.modules[module_spec.name] = module
-        module_spec.loader.exec_module(module)
-        setattr(parent, name, module)
-        modules[name] = module
-    cli = modules["_cli"]
+    """The wheel's dqjulia._cli as on Windows: os.name "nt" (its _native and _buildinfo imported
+    from the same folder, the package's __init__ not run: it would load nothing on Linux)."""
+    cli = load_package_module(os.path.join(package, "_cli.py"), "dqjulia_windows")
     cli.os = types.SimpleNamespace(name="nt", path=os.path)
     return cli
 
