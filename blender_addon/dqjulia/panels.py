@@ -88,6 +88,7 @@ class _Base:
 
 
 last_sidebar_draw = 0.0  # when the sidebar's main panel last drew (the screenshot script reads it)
+last_grid_draw = 0.0  # when the Variations panel last drew its grid to the end (preview_test.py reads it)
 
 
 class _MainPanel:
@@ -261,6 +262,8 @@ class _VariationsPanel(_Base):
             _wrapped(layout, "No thumbnail for " + line, icon="ERROR", alert=True)
         if grid.summary:
             _wrapped(layout, grid.summary)
+        global last_grid_draw
+        last_grid_draw = time.monotonic()
 
 
 class _BoundsPanel(_Base):

@@ -25,10 +25,10 @@ COUNT = 9  # a 3 x 3 grid
 MIN_STRENGTH = 0.01  # the library's range of strengths: 0.01 to 1
 GROUP_BITS = {name: native.GROUPS[name] for name, _label, _help in props.VARIATION_GROUP_ITEMS}
 STRENGTH_WORDS = (  # README "Variations of a fractal you like", docs/variations.md
-    (0.05, "tiny", "the same fractal with its details moved a little"),
+    (0.05, "tiny", "details move"),
     (0.15, "small", "a close relative"),
-    (0.3, "medium", "a sibling: related, noticeably different"),
-    (0.6, "large", "a cousin from the same neighbourhood"),
+    (0.3, "medium", "a sibling"),
+    (0.6, "large", "a cousin"),
     (1.0, "huge", "a stranger"),
 )
 
