@@ -1,12 +1,13 @@
 """Background work: bakes and variations run in a worker thread, never on Blender's main thread.
 
 A Job is a list of tasks (a VDB bake, a mesh: one native call each; a grid of variations: the
-variations, then a thumbnail of each) run one after another in a thread. ctypes releases the GIL for the whole native call, so Blender stays responsive;
-the core reports progress through a ctypes callback (native.Progress), which records the
-fraction and returns 1 once cancel() was asked, and the call then ends with
-DQJ_ERROR_CANCELLED. Nothing here touches bpy: the worker only fills plain Python objects,
-and the operator that owns the job (operators.py) polls it from a modal timer on the main
-thread, shows its progress, and builds Blender objects only when it has succeeded.
+variations, then a thumbnail of each) run one after another in a thread. ctypes releases the
+GIL for the whole native call, so Blender stays responsive; the core reports progress through
+a ctypes callback (native.Progress), which records the fraction and returns 1 once cancel() was
+asked, and the call then ends with DQJ_ERROR_CANCELLED. Nothing here touches bpy: the worker
+only fills plain Python objects, and the operator that owns the job (operators.py,
+variations.py) polls it from a modal timer on the main thread, shows its progress, and builds
+Blender objects only when it has succeeded.
 
 Typed (scripts/check-style.sh runs mypy on it, for Python 3.9 as native.py; Blender's Pythons are newer).
 """
@@ -166,9 +167,7 @@ class VariationsTask(_TaskBase):
 
     def run(self, context: native.Context, progress: native.Progress) -> List[Thumbnail]:
         self.part = (0.0, self.COMPUTE_SHARE)
-        self.warning = context.variations_compute(
-            self.seed, self.strength, self.locked_groups, self.count, progress
-        )
+        self.warning = context.variations_compute(self.seed, self.strength, self.locked_groups, self.count, progress)
         self.summary = context.variations()
         texts = [context.variation_params_json(index) for index in range(self.summary["count"])]
         described = self.summary["variations"]

@@ -222,9 +222,7 @@ def start_grid(obj, synchronous):
         grid.message = str(error)
         return grid
     _histories.setdefault(obj.name, History(grid.centre)).visit(grid.centre)
-    task = jobs.VariationsTask(
-        json.loads(grid.centre), grid.seed, grid.strength, _locks_bits(settings), count=COUNT
-    )
+    task = jobs.VariationsTask(json.loads(grid.centre), grid.seed, grid.strength, _locks_bits(settings), count=COUNT)
     grid.thumbnails = task.thumbnails
     grid.job = jobs.Job("Variations", [task])
     grid.running = True
@@ -416,7 +414,7 @@ def _refresh_around(context, obj):
 
 
 class DQJULIA_OT_variation_apply(bpy.types.Operator):
-    """Apply this variation to the object (Ctrl-Z returns to the original); it becomes the centre of the next variations"""
+    """Apply this variation to the object (Ctrl-Z returns to the original); the next variations vary it"""
 
     bl_idname = "dqjulia.variation_apply"
     bl_label = "Apply Variation"

@@ -730,8 +730,12 @@ def check_variations():
     for what, setting, value, expected in (
         ("a strength out of range", "variation_strength", 0.0, "out of range"),
         ("every group locked", "variation_locks", {item[0] for item in props.VARIATION_GROUP_ITEMS}, "unlock"),
-        ("too few found (b alone, tiny)", "variation_locks", {"a", "orientation", "origin", "iterations", "variant"},
-         "loosen the settings"),
+        (
+            "too few found (b alone, tiny)",
+            "variation_locks",
+            {"a", "orientation", "origin", "iterations", "variant"},
+            "loosen the settings",
+        ),
     ):
         saved = getattr(obj.dqjulia, setting)
         setattr(obj.dqjulia, setting, value)

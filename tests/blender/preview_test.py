@@ -510,8 +510,7 @@ def step_variations(obj):
         yield 0.02
     check(
         result == {"RUNNING_MODAL"} and grid.job.state == jobs.Job.CANCELLED and "Stopped" in grid.message,
-        "Esc stops a Refresh (%d of %d thumbnails made): %r"
-        % (len(grid.thumbnails), variations.COUNT, grid.message),
+        "Esc stops a Refresh (%d of %d thumbnails made): %r" % (len(grid.thumbnails), variations.COUNT, grid.message),
     )
     if ARGS.screenshots:
         yield from variations_screenshot(obj, refresh)
