@@ -501,6 +501,28 @@ def step_variations(obj):
         yield 0.1
     check(panels.last_grid_draw > 0.0, "the sidebar's Variations panel draws its grid")
 
+    # A click on a thumbnail's number: applied, and the next grid starts modal around the pick.
+    with bpy.context.temp_override(window=window, area=area, region=region, active_object=obj, object=obj):
+        result = bpy.ops.dqjulia.variation_apply("INVOKE_DEFAULT", True, index=1)
+    picked = variations.grid_for(obj)
+    check(
+        result == {"FINISHED"} and picked is not grid and picked.running,
+        "a pick in the window starts the next grid in the background",
+    )
+    waited = time.monotonic()
+    while picked.running and time.monotonic() - waited < 60.0:
+        yield 0.02
+    check(
+        picked.job.state == jobs.Job.DONE
+        and len(picked.icons) == variations.COUNT
+        and not variations.stale(obj, picked),
+        "and fills it around the pick (%s)" % picked.summary,
+    )
+
+    # A long search for Esc to stop (b alone at tiny strength: every candidate looks the same, so
+    # the library tries all 540 before it gives up), long against a redraw under llvmpipe.
+    obj.dqjulia.variation_locks = {"a", "orientation", "origin", "iterations", "variant"}
+    obj.dqjulia.variation_strength = 0.05
     result = refresh()
     window.event_simulate(type="ESC", value="PRESS")
     window.event_simulate(type="ESC", value="RELEASE")
@@ -512,6 +534,7 @@ def step_variations(obj):
         result == {"RUNNING_MODAL"} and grid.job.state == jobs.Job.CANCELLED and "Stopped" in grid.message,
         "Esc stops a Refresh (%d of %d thumbnails made): %r" % (len(grid.thumbnails), variations.COUNT, grid.message),
     )
+    obj.dqjulia.variation_locks, obj.dqjulia.variation_strength = {"variant"}, 0.3
     if ARGS.screenshots:
         yield from variations_screenshot(obj, refresh)
 
