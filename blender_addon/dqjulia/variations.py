@@ -52,14 +52,13 @@ class Grid:
 
     generation = 0  # numbers every grid, so their previews never share a name
 
-    def __init__(self, source, seed, strength, locks):
+    def __init__(self, source, seed, strength):
         Grid.generation += 1
         self.key = "g%d" % Grid.generation
         self.source = source  # the object's values it varies, as props.to_document gave them
         self.centre = ""  # the same as the core's complete document
         self.seed = seed
         self.strength = strength
-        self.locks = locks
         self.thumbnails = []
         self.icons = {}  # slot index -> preview icon id (0 in background mode)
         self.message = ""  # an error to show in the panel
@@ -201,7 +200,7 @@ def start_grid(obj, synchronous):
     source = json.dumps(document, sort_keys=True)
     # The strength as the panel shows it (Blender keeps a float: 0.15 is 0.1500000059...).
     strength = round(settings.variation_strength, 4)
-    grid = Grid(source, settings.variation_seed, strength, sorted(settings.variation_locks))
+    grid = Grid(source, settings.variation_seed, strength)
     _grids[obj.name] = grid
     state = core_state.state_for(obj)
     if state.error or state.empty_reason:
@@ -213,7 +212,7 @@ def start_grid(obj, synchronous):
             MIN_STRENGTH,
         )
         return grid
-    if len(grid.locks) == len(GROUP_BITS):
+    if len(settings.variation_locks) == len(GROUP_BITS):
         grid.message = "Every group is kept as it is, so nothing can vary: unlock at least one"
         return grid
     try:
@@ -408,7 +407,9 @@ def _refresh_around(context, obj):
     """After a pick: the next grid around the object's new values (in the background where
     there is a window)."""
     if context.window is not None and not bpy.app.background:
-        bpy.ops.dqjulia.variations_refresh("INVOKE_DEFAULT", next_seed=False)
+        # The object named, not the context's: the properties editor may still show the original.
+        with context.temp_override(object=obj, active_object=obj):
+            bpy.ops.dqjulia.variations_refresh("INVOKE_DEFAULT", next_seed=False)
     else:
         start_grid(obj, synchronous=True)
 

@@ -458,6 +458,13 @@ class Bake:
         return bool(running) or time.monotonic() - self.started < 0.3
 
 
+def make_active_in_window(obj):
+    for other in bpy.context.view_layer.objects:
+        other.select_set(False)
+    obj.select_set(True)
+    bpy.context.view_layer.objects.active = obj
+
+
 def step_variations(obj):
     """The Variations panel in the window. Generator: yields while the grid fills in."""
     import dqjulia.panels as panels
@@ -518,6 +525,23 @@ def step_variations(obj):
         and not variations.stale(obj, picked),
         "and fills it around the pick (%s)" % picked.summary,
     )
+    # Apply to a copy: the next grid is the copy's, the original keeps its values and its grid.
+    before = set(bpy.data.objects.keys())
+    with bpy.context.temp_override(window=window, area=area, region=region, active_object=obj, object=obj):
+        result = bpy.ops.dqjulia.variation_apply("INVOKE_DEFAULT", True, index=2, copy=True)
+    added = [bpy.data.objects[name] for name in set(bpy.data.objects.keys()) - before]
+    copy_grid = variations.grid_for(added[0]) if len(added) == 1 else None
+    check(
+        result == {"FINISHED"} and copy_grid is not None and variations.grid_for(obj) is picked,
+        "a pick applied to a copy varies the copy next; the original keeps its grid",
+    )
+    waited = time.monotonic()
+    while copy_grid is not None and copy_grid.running and time.monotonic() - waited < 60.0:
+        yield 0.02
+    check(not variations.stale(obj, picked), "and its values")
+    for extra in added:
+        bpy.data.objects.remove(extra)
+    make_active_in_window(obj)
 
     # A long search for Esc to stop (b alone at tiny strength: every candidate looks the same, so
     # the library tries all 540 before it gives up), long against a redraw under llvmpipe.
