@@ -6,7 +6,8 @@ python/dqjulia/_native.py, which the build copies into the zip), props.py (the
 parameters on the object and the parameter file's JSON), slicing.py (the slice's 8-D axes),
 animation.py (keyframes), core_state.py (what the core says about each object's parameters:
 the state the other modules share), preview.py (the GLSL preview), jobs.py (work in a thread),
-bakes.py (cache folder, objects from bakes), operators.py, farm.py (farm tasks' bakes), panels.py,
+bakes.py (cache folder, objects from bakes), operators.py, variations.py (the Variations grid,
+its thumbnails and picks), farm.py (farm tasks' bakes), panels.py,
 osl.py, shaders/.
 """
 
@@ -24,7 +25,7 @@ bl_info = {
 import bpy
 from bpy.props import StringProperty
 
-from . import bakes, core_state, farm, jobs, native, operators, osl, panels, preview, props
+from . import bakes, core_state, farm, jobs, native, operators, osl, panels, preview, props, variations
 
 
 class DQJuliaPreferences(bpy.types.AddonPreferences):
@@ -71,6 +72,7 @@ def register():
     props.register()
     core_state.register()
     operators.register()
+    variations.register()
     farm.register()
     panels.register()
     osl.register()
@@ -87,6 +89,7 @@ def unregister():
     osl.unregister()
     panels.unregister()
     farm.unregister()
+    variations.unregister()
     operators.unregister()
     core_state.unregister()
     props.unregister()

@@ -1,12 +1,13 @@
-"""Background work: bakes run in a worker thread, never on Blender's main thread.
+"""Background work: bakes and variations run in a worker thread, never on Blender's main thread.
 
-A Job is a list of tasks (one native call each: a VDB bake, a mesh) run one after another
-in a thread. ctypes releases the GIL for the whole native call, so Blender stays responsive;
-the core reports progress through a ctypes callback (native.Progress), which records the
-fraction and returns 1 once cancel() was asked, and the call then ends with
-DQJ_ERROR_CANCELLED. Nothing here touches bpy: the worker only fills plain Python objects,
-and the operator that owns the job (operators.py) polls it from a modal timer on the main
-thread, shows its progress, and builds Blender objects only when it has succeeded.
+A Job is a list of tasks (a VDB bake, a mesh: one native call each; a grid of variations: the
+variations, then a thumbnail of each) run one after another in a thread. ctypes releases the
+GIL for the whole native call, so Blender stays responsive; the core reports progress through
+a ctypes callback (native.Progress), which records the fraction and returns 1 once cancel() was
+asked, and the call then ends with DQJ_ERROR_CANCELLED. Nothing here touches bpy: the worker
+only fills plain Python objects, and the operator that owns the job (operators.py,
+variations.py) polls it from a modal timer on the main thread, shows its progress, and builds
+Blender objects only when it has succeeded.
 
 Typed (scripts/check-style.sh runs mypy on it, for Python 3.9 as native.py; Blender's Pythons are newer).
 """
@@ -15,10 +16,11 @@ from __future__ import annotations
 
 import array
 import ctypes
+import json
 import os
 import threading
 import time
-from typing import Any, Dict, List, Optional, Sequence, Union
+from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 from . import native
 
@@ -67,16 +69,28 @@ def _as_array(typecode: str, ctypes_array: ctypes.Array[Any]) -> array.array[Any
     return result
 
 
-class VolumeTask:
+class _TaskBase:
+    """What every task has: its document, the warning its native call gave, and `part`, the
+    share of the task's progress its current native call covers (start, width): a task of
+    several native calls moves it before each."""
+
+    kind = ""
+
+    def __init__(self, document: Dict[str, Any]) -> None:
+        self.document = document
+        self.warning = ""
+        self.part: Tuple[float, float] = (0.0, 1.0)
+
+
+class VolumeTask(_TaskBase):
     """Bakes one document to a VDB file (grids "surface" and "density" at least)."""
 
     kind = "volume"
 
     def __init__(self, document: Dict[str, Any], path: str, frame: Optional[int] = None) -> None:
-        self.document = document
+        super().__init__(document)
         self.path = path
         self.frame = frame
-        self.warning = ""
 
     def run(self, context: native.Context, progress: native.Progress) -> str:
         directory = os.path.dirname(self.path)
@@ -86,15 +100,14 @@ class VolumeTask:
         return self.path
 
 
-class MeshTask:
+class MeshTask(_TaskBase):
     """Meshes one document's surface and copies the mesh out of the core."""
 
     kind = "mesh"
 
     def __init__(self, document: Dict[str, Any], colors: bool = True) -> None:
-        self.document = document
+        super().__init__(document)
         self.colors = colors
-        self.warning = ""
 
     def run(self, context: native.Context, progress: native.Progress) -> MeshData:
         self.warning = context.mesh_compute(progress)
@@ -108,8 +121,83 @@ class MeshTask:
         )
 
 
-# One task of a Job: a native call with its document.
-Task = Union[VolumeTask, MeshTask]
+THUMBNAIL_SIZE = 128  # pixels, square: a variation's picture in the grid
+
+
+class Thumbnail:
+    """One slot of a grid of variations, filled by the worker: the variation's complete document
+    (JSON text, as the core gives it), then its picture (RGBA8, sRGB, rows top-down) or why it
+    has none."""
+
+    def __init__(self, index: int, text: str, description: str) -> None:
+        self.index = index
+        self.text = text
+        self.description = description
+        self.pixels: Optional[bytes] = None
+        self.error = ""
+
+    @property
+    def done(self) -> bool:
+        return self.pixels is not None or bool(self.error)
+
+
+class VariationsTask(_TaskBase):
+    """Variations of one document (dqj_variations_compute: `count` documents, each proven
+    non-empty, not dust, not a ball, not tiny, no two alike), then each one's thumbnail rendered
+    by the core in the document's own look (its material, palette and lights; one sample a
+    pixel). `thumbnails` grows as the worker goes: the main thread may read it at any time (a
+    slot appears complete, its picture or its error set before it is appended). A thumbnail
+    that fails to render keeps its reason and the others go on; the variations failing (a
+    strength out of range, every group locked, an empty start, too few found) fail the task
+    with the core's message."""
+
+    kind = "variations"
+    COMPUTE_SHARE = 0.3  # of the progress: the search; the thumbnails share the rest
+
+    def __init__(
+        self, document: Dict[str, Any], seed: int, strength: float, locked_groups: int, count: int = 9
+    ) -> None:
+        super().__init__(document)
+        self.seed = seed
+        self.strength = strength
+        self.locked_groups = locked_groups
+        self.count = count
+        self.summary: Dict[str, Any] = {}
+        self.thumbnails: List[Thumbnail] = []
+
+    def run(self, context: native.Context, progress: native.Progress) -> List[Thumbnail]:
+        self.part = (0.0, self.COMPUTE_SHARE)
+        self.warning = context.variations_compute(self.seed, self.strength, self.locked_groups, self.count, progress)
+        self.summary = context.variations()
+        texts = [context.variation_params_json(index) for index in range(self.summary["count"])]
+        described = self.summary["variations"]
+        share = (1.0 - self.COMPUTE_SHARE) / max(1, len(texts))
+        for index, text in enumerate(texts):
+            self.part = (self.COMPUTE_SHARE + index * share, share)
+            slot = Thumbnail(index, text, str(described[index].get("description", "")))
+            slot.pixels, slot.error = self.thumbnail(context, text, progress)
+            self.thumbnails.append(slot)
+        return self.thumbnails
+
+    @staticmethod
+    def thumbnail(context: native.Context, text: str, progress: native.Progress) -> Tuple[Optional[bytes], str]:
+        """(pixels, "") or (None, why): a cancel is raised, any other failure kept."""
+        document = json.loads(text)
+        document.setdefault("render", {})["samples"] = 1
+        try:
+            context.set_params(document)
+            pixels, _warning = context.render_rgba8(THUMBNAIL_SIZE, THUMBNAIL_SIZE, progress)
+            return pixels, ""
+        except native.NativeError as error:
+            if error.cancelled or progress.cancelled:
+                raise
+            return None, error.message
+        except native.NativeUnavailable as error:
+            return None, str(error)
+
+
+# One task of a Job: native calls with a document.
+Task = Union[VolumeTask, MeshTask, VariationsTask]
 
 
 def format_duration(seconds: float) -> str:
@@ -138,7 +226,7 @@ class Job:
         self.label = label
         self.owner = owner  # the object's name, for the panel
         self.tasks = list(tasks)
-        self.results: List[Union[str, MeshData]] = []  # each task's: a VDB file's path, a mesh
+        self.results: List[Union[str, MeshData, List[Thumbnail]]] = []  # each task's: a VDB's path, a mesh, ...
         self.state = Job.RUNNING
         self.error = ""
         self.warnings: List[str] = []
@@ -159,6 +247,9 @@ class Job:
         return min(1.0, (self.index + self._task_fraction) / len(self.tasks))
 
     def _on_progress(self, fraction: float) -> None:
+        if self.index < len(self.tasks):
+            start, width = self.tasks[self.index].part
+            fraction = start + width * fraction
         self._task_fraction = fraction
 
     def status_text(self) -> str:

@@ -8,7 +8,7 @@ import time
 
 import bpy
 
-from . import bakes, core_state, jobs, native, operators, osl, preview, props
+from . import bakes, core_state, jobs, native, operators, osl, preview, props, variations
 
 
 def _wrapped(layout, text, icon="NONE", alert=False, width=None):
@@ -88,6 +88,7 @@ class _Base:
 
 
 last_sidebar_draw = 0.0  # when the sidebar's main panel last drew (the screenshot script reads it)
+last_grid_draw = 0.0  # when the Variations panel last drew its grid to the end (preview_test.py reads it)
 
 
 class _MainPanel:
@@ -182,6 +183,87 @@ class _SlicePanel(_Base):
         add.collection, add.action = "rotations", "ADD"
         remove = column.operator(operators.DQJULIA_OT_collection_edit.bl_idname, text="", icon="REMOVE")
         remove.collection, remove.action, remove.index = "rotations", "REMOVE", s.active_rotation
+
+
+class _VariationsPanel(_Base):
+    """A grid of variations of the object (variations.py): strength, locks, Refresh, Back and
+    Forward, and the thumbnails; a click applies one (or applies it to a copy)."""
+
+    bl_label = "Variations"
+
+    def draw(self, context):
+        obj = operators.dqjulia_object(context)
+        s = obj.dqjulia
+        layout = self.layout
+        why = variations.unavailable()
+        if why is not None:
+            _wrapped(layout, why, icon="ERROR", alert=True)
+            return
+        column = layout.column(align=True)
+        column.prop(s, "variation_strength", slider=True)
+        column.label(text=variations.strength_words(s.variation_strength))
+        layout.label(text="Keep as they are:")
+        flow = layout.grid_flow(columns=3, even_columns=True, align=True)
+        for name, _label, _description in props.VARIATION_GROUP_ITEMS:
+            flow.prop_enum(s, "variation_locks", name)
+        grid = variations.grid_for(obj)
+        history = variations.history_for(obj)
+        row = layout.row(align=True)
+        refresh = row.operator(
+            variations.DQJULIA_OT_variations_refresh.bl_idname,
+            text="Refresh" if grid is not None else "Show Variations",
+            icon="FILE_REFRESH",
+        )
+        refresh.next_seed = grid is not None
+        for step, icon in ((-1, "BACK"), (1, "FORWARD")):
+            button = row.row(align=True)
+            button.enabled = history is not None and history.can_step(step)
+            button.operator(variations.DQJULIA_OT_variations_history.bl_idname, text="", icon=icon).step = step
+        if grid is None:
+            return
+        if grid.running:
+            row = layout.row()
+            row.label(
+                text="Making variations: %d of %d (Esc stops)" % (len(grid.thumbnails), variations.COUNT),
+                icon="TIME",
+            )
+        if grid.message:
+            _wrapped(layout.box(), grid.message, icon="ERROR" if not grid.thumbnails else "INFO", alert=True)
+        elif variations.stale(obj, grid):
+            _wrapped(layout, "The object changed since: Refresh varies its current values.", icon="INFO")
+        self._thumbnails(context, layout, grid)
+
+    @staticmethod
+    def _thumbnails(context, layout, grid):
+        if not grid.thumbnails and not grid.running:
+            return
+        region = context.region
+        ui_scale = context.preferences.system.ui_scale
+        width = (region.width if region else 300) - 40 * ui_scale
+        scale = max(2.0, width / 3.0 / (20.0 * ui_scale))
+        flow = layout.grid_flow(row_major=True, columns=3, even_columns=True, even_rows=True, align=False)
+        failed = []
+        for index in range(variations.COUNT):
+            column = flow.column(align=True)
+            preview = variations.preview_of(grid, index)
+            column.template_icon(
+                icon_value=preview.icon_id if preview is not None else variations.placeholder_icon(), scale=scale
+            )
+            error = variations.slot_error(grid, index)
+            if error:
+                failed.append("%d: %s" % (index + 1, error))
+            row = column.row(align=True)
+            row.enabled = preview is not None
+            apply = row.operator(variations.DQJULIA_OT_variation_apply.bl_idname, text=str(index + 1))
+            apply.index = index
+            copy = row.operator(variations.DQJULIA_OT_variation_apply.bl_idname, text="", icon="DUPLICATE")
+            copy.index, copy.copy = index, True
+        for line in failed:
+            _wrapped(layout, "No thumbnail for " + line, icon="ERROR", alert=True)
+        if grid.summary:
+            _wrapped(layout, grid.summary)
+        global last_grid_draw
+        last_grid_draw = time.monotonic()
 
 
 class _BoundsPanel(_Base):
@@ -355,7 +437,7 @@ def _make_panels():
         main_id = "%s_PT_dqjulia" % prefix
         main = type(main_id, (_MainPanel, bpy.types.Panel), dict(placement, bl_idname=main_id))
         classes.append(main)
-        for base in (_SlicePanel, _BoundsPanel, _PreviewPanel, _BakePanel, _OslPanel, _ShadingPanel):
+        for base in (_VariationsPanel, _SlicePanel, _BoundsPanel, _PreviewPanel, _BakePanel, _OslPanel, _ShadingPanel):
             name = "%s_PT_dqjulia_%s" % (prefix, base.__name__.strip("_").replace("Panel", "").lower())
             attributes = dict(placement, bl_idname=name, bl_parent_id=main_id)
             classes.append(type(name, (base, bpy.types.Panel), attributes))

@@ -73,6 +73,15 @@ GRID_ITEMS = choice_items("bake.grids")
 AXIS_ITEMS = [
     (name, name, "%s part, %s component" % ("real" if name[0] == "a" else "dual", name[2])) for name in AXIS_NAMES
 ]
+# The groups a variation may change (native.GROUPS, `dqjulia explore --lock`'s names).
+VARIATION_GROUP_ITEMS = [
+    ("a", "a", "The constant's real part a"),
+    ("b", "b", "The constant's dual part b"),
+    ("orientation", "Orientation", "The slice's rotations"),
+    ("origin", "Origin", "The slice's origin"),
+    ("iterations", "Iterations", "N and the bailout R"),
+    ("variant", "Variant", "The variant (changed only from strength large on)"),
+]
 AXES_MODE_ITEMS = [
     ("NAMES", "Axis names", "Each of x, y, z runs along one 8-D coordinate axis"),
     ("VECTORS", "Vectors", "Each of x, y, z runs along an 8-D vector"),
@@ -279,6 +288,31 @@ _settings = {
         soft_max=8.0,
         update=_redraw,
         description="Hit threshold in pixels for the preview",
+    ),
+    # the Variations panel's settings (not in the file; variations.py)
+    "variation_strength": FloatProperty(
+        name="Strength",
+        default=0.3,
+        min=0.0,
+        max=1.0,
+        step=1,
+        precision=2,
+        description="How far the variations go: 0.05 tiny (details move a little), 0.15 small (a close relative), "
+        "0.3 medium (a sibling), 0.6 large (a cousin), 1 huge (a stranger); the library takes 0.01 to 1",
+    ),
+    "variation_locks": EnumProperty(
+        name="Keep",
+        items=VARIATION_GROUP_ITEMS,
+        options={"ENUM_FLAG"},
+        default={"variant"},
+        description="The groups the variations keep as they are, bit for bit",
+    ),
+    "variation_seed": IntProperty(
+        name="Seed",
+        default=1,
+        min=0,
+        description="The variations' random seed: the same seed, strength and locks give the same variations "
+        "(Refresh moves to the next)",
     ),
     # sections of an imported file this version does not model, written back on export
     "extra_json": StringProperty(name="Other sections", default="{}", options={"HIDDEN"}),

@@ -14,7 +14,11 @@ folders the runner (run_blender.cmake) points BLENDER_USER_* at, then runs its c
   moved_project a moved project renders its volume from the new place; a missing file is reported
   schema        every property built from the core's schema: keys, defaults, ranges and choices as the
                 library loaded says (dqj_params_schema_json), and a fresh object's document is the default
-  parameters    a new object holds the core's defaults; the core validates every change
+  parameters    a new object holds the core's defaults; the core validates every change; the Variations
+                panel's operators: Refresh fills the previews with the library's own thumbnails of the
+                library's variations, a pick sets exactly its document in one undo step and becomes the
+                centre, Back and Forward, Apply to a copy keeps the original, bad input and a failing
+                thumbnail give a message in the panel
   presets       presets, import/export round trips of every example, a bad file
   slice         the Python slice against the core's
   keyframes     keyframes <-> the file's "animation" (export, import, each frame's values)
@@ -602,6 +606,183 @@ def case_parameters():
     )
     obj.dqjulia.bailout = 4.0
     check(core_state.state_for(obj).error is None, "and the valid value clears it")
+    check_variations()
+
+
+def object_document(obj):
+    """The object's values as the core's complete document (a dict)."""
+    with native.Context() as context:
+        context.set_params(props.to_document(obj.dqjulia))
+        return context.params()
+
+
+def packed_rows_bottom_up(pixels, size):
+    """The core's RGBA8 rows (top-down) as an ImagePreview's image_pixels: one int a pixel,
+    rows bottom-up."""
+    flipped = b"".join(pixels[4 * size * row : 4 * size * (row + 1)] for row in range(size - 1, -1, -1))
+    packed = array.array("i")
+    packed.frombytes(flipped)
+    return list(packed)
+
+
+def check_variations():
+    """The Variations panel's operators, as its buttons call them (background: synchronously)."""
+    variations = common.submodule(dqjulia, "variations")
+    clear_scene()
+    obj = new_dqjulia()
+    make_active(obj)
+    name = obj.name
+    s = obj.dqjulia
+    s.variation_seed, s.variation_strength, s.variation_locks = 5, 0.15, {"variant", "iterations"}
+    original = object_document(obj)
+    started = time.monotonic()
+    result = bpy.ops.dqjulia.variations_refresh(next_seed=False)
+    grid = variations.grid_for(obj)
+    check(
+        result == {"FINISHED"} and len(grid.thumbnails) == variations.COUNT and not grid.message,
+        "Refresh makes %d variations with thumbnails in %.2f s: %s"
+        % (len(grid.thumbnails), time.monotonic() - started, grid.summary),
+    )
+    # The same variations and pictures straight from the library: the panel shows the core's own.
+    size = jobs.THUMBNAIL_SIZE
+    with native.Context(original) as context:
+        context.variations_compute(5, 0.15, native.GROUP_VARIANT | native.GROUP_ITERATIONS, variations.COUNT)
+        texts = [context.variation_params_json(index) for index in range(variations.COUNT)]
+        same_pixels = 0
+        for index, text in enumerate(texts):
+            document = json.loads(text)
+            document["render"]["samples"] = 1
+            context.set_params(document)
+            pixels, _warning = context.render_rgba8(size, size)
+            preview = variations.preview_of(grid, index)
+            if (
+                preview is not None
+                and tuple(preview.image_size) == (size, size)
+                and list(preview.image_pixels) == packed_rows_bottom_up(pixels, size)
+            ):
+                same_pixels += 1
+    check(
+        [thumbnail.text for thumbnail in grid.thumbnails] == texts,
+        "the grid's variations are the library's for the object's seed, strength and locks",
+    )
+    check(
+        same_pixels == variations.COUNT,
+        "%d of %d previews hold exactly the library's %dx%d render of their variation"
+        % (same_pixels, variations.COUNT, size, size),
+    )
+    check(
+        len({thumbnail.pixels for thumbnail in grid.thumbnails}) == variations.COUNT,
+        "the %d thumbnails are all different pictures" % variations.COUNT,
+    )
+
+    # A pick: exactly its document, one undo step back to the original.
+    bpy.ops.ed.undo_push(message="before the pick")  # background mode starts without an undo stack
+    pick = json.loads(grid.thumbnails[4].text)
+    result = bpy.ops.dqjulia.variation_apply("EXEC_DEFAULT", True, index=4, refresh=False)  # True: as a click, undoable
+    check(
+        result == {"FINISHED"} and object_document(obj) == pick,
+        "applying variation 5 sets the object's properties to exactly its document",
+    )
+    check(pick != original, "which differs from the original")
+    bpy.ops.ed.undo()
+    obj = bpy.data.objects[name]
+    check(object_document(obj) == original, "one undo restores the original")
+    check(variations.stale(obj, variations.grid_for(obj)) is False, "and the grid is the original's again")
+
+    # The pick becomes the centre; Back and Forward go through the picks.
+    make_active(obj)
+    result = bpy.ops.dqjulia.variation_apply(index=4)
+    grid = variations.grid_for(obj)
+    with native.Context(pick) as context:
+        pick_text = context.params_json()
+    check(
+        result == {"FINISHED"}
+        and grid.centre == pick_text
+        and len(grid.thumbnails) == variations.COUNT
+        and not variations.stale(obj, grid),
+        "the pick is the centre of the next grid (%s)" % grid.summary,
+    )
+    history = variations.history_for(obj)
+    check(history.index == 1 and len(history.entries) == 2, "the history holds the original and the pick")
+    result = bpy.ops.dqjulia.variations_history(step=-1)
+    check(result == {"FINISHED"} and object_document(obj) == original, "Back returns to the original")
+    check(variations.grid_for(obj).centre != pick_text, "and varies around it")
+    result = bpy.ops.dqjulia.variations_history(step=1, refresh=False)
+    check(result == {"FINISHED"} and object_document(obj) == pick, "Forward returns to the pick")
+    result, error = common.call(bpy.ops.dqjulia.variations_history, step=1)
+    check(result == {"CANCELLED"}, "there is nothing after the last pick: %s" % error)
+
+    # Apply to a copy: the original stays as it was.
+    bpy.ops.dqjulia.variations_history(step=-1)
+    grid = variations.grid_for(obj)
+    objects_before = set(bpy.data.objects.keys())
+    copy_pick = json.loads(grid.thumbnails[2].text)
+    result = bpy.ops.dqjulia.variation_apply(index=2, copy=True, refresh=False)
+    added = set(bpy.data.objects.keys()) - objects_before
+    copy = bpy.data.objects[added.pop()] if len(added) == 1 else None
+    check(result == {"FINISHED"} and copy is not None and copy.dqjulia.enabled, "Apply to a copy adds one object")
+    check(copy is not None and object_document(copy) == copy_pick, "the copy holds the variation's document")
+    check(object_document(obj) == original, "the original is untouched")
+    check(bpy.context.view_layer.objects.active == copy, "the copy is active")
+
+    # Bad input: a message for the panel, never a traceback.
+    make_active(obj)
+    for what, setting, value, expected in (
+        ("a strength out of range", "variation_strength", 0.0, "out of range"),
+        ("every group locked", "variation_locks", {item[0] for item in props.VARIATION_GROUP_ITEMS}, "unlock"),
+        (
+            "too few found (b alone, tiny)",
+            "variation_locks",
+            {"a", "orientation", "origin", "iterations", "variant"},
+            "loosen the settings",
+        ),
+    ):
+        saved = getattr(obj.dqjulia, setting)
+        setattr(obj.dqjulia, setting, value)
+        if setting == "variation_locks" and "b" not in value:
+            obj.dqjulia.variation_strength = 0.05
+        result, error = common.call(bpy.ops.dqjulia.variations_refresh)
+        grid = variations.grid_for(obj)
+        check(
+            result == {"CANCELLED"} and expected in grid.message and not grid.thumbnails,
+            "%s: the panel says %r" % (what, grid.message[:110]),
+        )
+        setattr(obj.dqjulia, setting, saved)
+        obj.dqjulia.variation_strength = 0.15
+    bpy.ops.dqjulia.load_preset(preset="paper-test2-1")
+    result, error = common.call(bpy.ops.dqjulia.variations_refresh)
+    grid = variations.grid_for(obj)
+    check(
+        result == {"CANCELLED"} and "Nothing to vary" in grid.message,
+        "an empty start: the panel says %r" % grid.message[:110],
+    )
+    clear_scene()
+    obj = new_dqjulia()
+    make_active(obj)
+
+    # A thumbnail that fails to render leaves an empty slot with its reason; the others come.
+    calls = []
+    real_render = native.Context.render_rgba8
+
+    def failing_render(self, width, height, progress=None):
+        calls.append(width)
+        if len(calls) == 3:
+            raise native.NativeError(native.ERROR_INTERNAL, "render: a test's failure")
+        return real_render(self, width, height, progress)
+
+    native.Context.render_rgba8 = failing_render
+    try:
+        result = bpy.ops.dqjulia.variations_refresh()
+    finally:
+        native.Context.render_rgba8 = real_render
+    grid = variations.grid_for(obj)
+    shown = [variations.preview_of(grid, index) is not None for index in range(variations.COUNT)]
+    check(
+        result == {"FINISHED"}
+        and variations.slot_error(grid, 2) == "render: a test's failure"
+        and shown == [index != 2 for index in range(variations.COUNT)],
+        "a failed thumbnail leaves slot 3 empty with its reason, the other 8 are shown",
+    )
 
 
 def case_presets():

@@ -14,7 +14,11 @@
 3. Bake Volume through the modal operator: Blender keeps running its timers while the worker
    bakes, progress is reported, the Volume object appears at the end.
 4. Esc (a simulated key press) cancels a bake: nothing is added, no file is left.
-With --screenshots DIR it also saves the README's screenshots there.
+5. The Variations panel: Refresh runs modal (it returns at once, the library's thumbnails arrive
+   in image previews while Blender's timers keep running), the panel draws its grid, and Esc
+   stops a Refresh.
+With --screenshots DIR it also saves the README's screenshots there (and the Variations panel's,
+docs/images/blender-variations.png).
 Blender runs this from timers; the exit status is 0 only if every check passed.
 """
 
@@ -36,6 +40,9 @@ from preview_compare import look_at, offscreen_preview  # noqa: E402
 
 def extra_arguments(parser):
     parser.add_argument("--screenshots", default="", help="save README screenshots to this folder")
+    parser.add_argument(
+        "--variations-scroll", type=int, default=8, help="steps the sidebar scrolls down to the Variations panel"
+    )
     preview_compare.add_arguments(parser)
 
 
@@ -451,6 +458,152 @@ class Bake:
         return bool(running) or time.monotonic() - self.started < 0.3
 
 
+def make_active_in_window(obj):
+    for other in bpy.context.view_layer.objects:
+        other.select_set(False)
+    obj.select_set(True)
+    bpy.context.view_layer.objects.active = obj
+
+
+def step_variations(obj):
+    """The Variations panel in the window. Generator: yields while the grid fills in."""
+    import dqjulia.panels as panels
+    from dqjulia import variations
+
+    window, area, region = window_area_region()
+    obj.dqjulia.variation_seed, obj.dqjulia.variation_strength = 1, 0.3
+
+    def refresh():
+        with bpy.context.temp_override(window=window, area=area, region=region, active_object=obj, object=obj):
+            return bpy.ops.dqjulia.variations_refresh("INVOKE_DEFAULT", next_seed=False)
+
+    started = time.monotonic()
+    result = refresh()
+    returned = time.monotonic() - started
+    grid = variations.grid_for(obj)
+    check(
+        result == {"RUNNING_MODAL"} and len(grid.icons) == 0,
+        "Refresh runs modal: it returned after %.3f s, before any thumbnail" % returned,
+    )
+    seen, ticks = [], 0
+    while grid.running and time.monotonic() - started < 60.0:
+        ticks += 1
+        if not seen or seen[-1][1] != len(grid.icons):
+            seen.append((round(time.monotonic() - started, 2), len(grid.icons)))
+        yield 0.02
+    seen.append((round(time.monotonic() - started, 2), len(grid.icons)))
+    report("previews shown over time (s, count): %s; %s" % (seen, grid.summary))
+    check(
+        grid.job.state == jobs.Job.DONE
+        and len(grid.icons) == variations.COUNT
+        and all(icon for icon in grid.icons.values()),
+        "the grid filled in with %d previews from the modal operator (Blender's timer ran %d times meanwhile)"
+        % (len(grid.icons), ticks),
+    )
+    area.spaces.active.show_region_ui = True
+    yield from _show_sidebar_tab(area)
+    panels.last_grid_draw = 0.0
+    for _ in range(3):
+        redraw()
+        yield 0.1
+    check(panels.last_grid_draw > 0.0, "the sidebar's Variations panel draws its grid")
+
+    # A click on a thumbnail's number: applied, and the next grid starts modal around the pick.
+    with bpy.context.temp_override(window=window, area=area, region=region, active_object=obj, object=obj):
+        result = bpy.ops.dqjulia.variation_apply("INVOKE_DEFAULT", True, index=1)
+    picked = variations.grid_for(obj)
+    check(
+        result == {"FINISHED"} and picked is not grid and picked.running,
+        "a pick in the window starts the next grid in the background",
+    )
+    waited = time.monotonic()
+    while picked.running and time.monotonic() - waited < 60.0:
+        yield 0.02
+    check(
+        picked.job.state == jobs.Job.DONE
+        and len(picked.icons) == variations.COUNT
+        and not variations.stale(obj, picked),
+        "and fills it around the pick (%s)" % picked.summary,
+    )
+    # Apply to a copy: the next grid is the copy's, the original keeps its values and its grid.
+    before = set(bpy.data.objects.keys())
+    with bpy.context.temp_override(window=window, area=area, region=region, active_object=obj, object=obj):
+        result = bpy.ops.dqjulia.variation_apply("INVOKE_DEFAULT", True, index=2, copy=True)
+    added = [bpy.data.objects[name] for name in set(bpy.data.objects.keys()) - before]
+    copy_grid = variations.grid_for(added[0]) if len(added) == 1 else None
+    check(
+        result == {"FINISHED"} and copy_grid is not None and variations.grid_for(obj) is picked,
+        "a pick applied to a copy varies the copy next; the original keeps its grid",
+    )
+    waited = time.monotonic()
+    while copy_grid is not None and copy_grid.running and time.monotonic() - waited < 60.0:
+        yield 0.02
+    check(not variations.stale(obj, picked), "and its values")
+    for extra in added:
+        bpy.data.objects.remove(extra)
+    make_active_in_window(obj)
+
+    # A long search for Esc to stop (b alone at tiny strength: every candidate looks the same, so
+    # the library tries all 540 before it gives up), long against a redraw under llvmpipe.
+    obj.dqjulia.variation_locks = {"a", "orientation", "origin", "iterations", "variant"}
+    obj.dqjulia.variation_strength = 0.05
+    result = refresh()
+    window.event_simulate(type="ESC", value="PRESS")
+    window.event_simulate(type="ESC", value="RELEASE")
+    grid = variations.grid_for(obj)
+    waited = time.monotonic()
+    while grid.running and time.monotonic() - waited < 60.0:
+        yield 0.02
+    check(
+        result == {"RUNNING_MODAL"} and grid.job.state == jobs.Job.CANCELLED and "Stopped" in grid.message,
+        "Esc stops a Refresh (%d of %d thumbnails made): %r" % (len(grid.thumbnails), variations.COUNT, grid.message),
+    )
+    obj.dqjulia.variation_locks, obj.dqjulia.variation_strength = {"variant"}, 0.3
+    if ARGS.screenshots:
+        yield from variations_screenshot(obj, refresh)
+
+
+def variations_screenshot(obj, refresh):
+    """docs/images/blender-variations.png: the sidebar scrolled to the Variations panel, its grid
+    around the paper's high-resolution figure."""
+    from dqjulia import variations
+
+    window, area, region = window_area_region()
+    with native.Context() as context:
+        context.load_params_file(os.path.join(os.path.dirname(dqjulia.__file__), "presets", "paper-highres.json"))
+        props.from_document(obj.dqjulia, context.params())
+    obj.dqjulia.variation_seed, obj.dqjulia.variation_strength = 1, 0.6
+    bpy.context.scene.view_settings.view_transform = "Standard"
+    refresh()
+    grid = variations.grid_for(obj)
+    while grid.running:
+        yield 0.05
+    # Widen the sidebar as a user does, dragging its left edge, then scroll down to the panel.
+    sidebar = next(r for r in area.regions if r.type == "UI")
+    narrow = sidebar.width
+    for offset in (0, 2, 4, -2, 6):
+        x, y = sidebar.x + offset, sidebar.y + sidebar.height // 3
+        window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x, y=y)
+        yield 0.1
+        window.event_simulate(type="LEFTMOUSE", value="PRESS", x=x, y=y)
+        yield 0.1
+        for step in range(1, 11):
+            window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x - 16 * step, y=y)
+            yield 0.05
+        window.event_simulate(type="LEFTMOUSE", value="RELEASE", x=x - 160, y=y)
+        yield 0.3
+        if sidebar.width > narrow:
+            break
+    report("the sidebar is %d pixels wide (was %d)" % (sidebar.width, narrow))
+    for _ in range(ARGS.variations_scroll):
+        with bpy.context.temp_override(window=window, area=area, region=sidebar):
+            bpy.ops.view2d.scroll_down(deltax=0, deltay=40)
+    for _ in range(4):
+        redraw()
+        yield 0.2
+    _shot(os.path.join(ARGS.screenshots, "blender-variations.png"), scale=1.0)
+
+
 def close_splash():
     """A fresh user folder makes Blender show its first-run splash over the viewport: Esc closes it."""
     window = bpy.context.window_manager.windows[0]
@@ -537,6 +690,9 @@ def run_steps():
         )
     else:
         check(False, "the library can bake (dqj_bake_vdb)")
+
+    yield from step_variations(obj)
+    yield 0.2
 
     step_first_render(obj)
     yield 0.2
