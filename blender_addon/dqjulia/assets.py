@@ -2,7 +2,8 @@
 library.
 
 Mark as Asset (mark()) makes the object an asset (Blender's ID.asset_mark) with its metadata (a
-description, the tags "DQ Julia", the variant and the colouring) and its preview: the library's
+description: the parameters' own, else one of the values; one typed in the Asset Browser is
+kept; the tags "DQ Julia", the variant and the colouring) and its preview: the library's
 own render of the object's parameters in the object's own look (jobs.render_thumbnail, the
 Variations grid's thumbnails), PREVIEW_SIZE pixels square, with an ICON_SIZE icon rendered the
 same way. No GPU and never Blender's generic icon: Blender keeps a preview set from Python
@@ -33,7 +34,7 @@ PREVIEW_SIZE = 256  # pixels, square: the Asset Browser's picture of the asset
 ICON_SIZE = 32  # its small icon (lists, menus)
 TAG = "DQ Julia"
 THUMBNAIL_OF = "dqjulia_thumbnail_of"  # asset_data: the values (JSON) its preview shows
-DESCRIBED = "DQ Julia set"  # how a description written by mark() starts (the user's own is kept)
+DESCRIBED = "dqjulia_description"  # asset_data: the description mark() wrote (one typed since is kept)
 LIBRARY_NAME = "DQ Julia"
 LIBRARY_FILE = "dqjulia-presets.blend"
 _LABELS = {name: label for name, label, _help in props.VARIANT_ITEMS + props.COLORING_ITEMS}
@@ -48,8 +49,7 @@ def describe(document):
     """A description from the values: the variant, the constant, the iterations."""
     fractal = document["fractal"]
     c = fractal["c"]
-    return "%s, %s variant: c = (%s) + (%s)\u03b5, %d iterations" % (
-        DESCRIBED,
+    return "DQ Julia set, %s variant: c = (%s) + (%s)\u03b5, %d iterations" % (
         _LABELS.get(fractal.get("variant"), fractal.get("variant", "")),
         ", ".join("%.4g" % x for x in c[:4]),
         ", ".join("%.4g" % x for x in c[4:]),
@@ -86,11 +86,9 @@ def mark(obj, tags=()):
     image, icon = render_previews(complete)
     obj.asset_mark()
     data = obj.asset_data
-    own = (complete.get("description") or "").strip()
-    if own:
-        data.description = own
-    elif not data.description or data.description.startswith(DESCRIBED):
-        data.description = describe(complete)
+    if not data.description or data.description == data.get(DESCRIBED):  # never one typed in the browser
+        data.description = (complete.get("description") or "").strip() or describe(complete)
+        data[DESCRIBED] = data.description
     fractal, material = complete["fractal"], complete["material"]
     wanted = [TAG, _LABELS.get(fractal["variant"], fractal["variant"])]
     wanted.append(_LABELS.get(material["coloring"], material["coloring"]))

@@ -892,6 +892,10 @@ def check_assets():
         obj.asset_data.description == assets.describe(document) and "iterations" in obj.asset_data.description,
         "without one, a description of its values: %r" % obj.asset_data.description,
     )
+    obj.asset_data.description = "a find of mine"
+    bpy.ops.dqjulia.mark_asset()
+    check(obj.asset_data.description == "a find of mine", "a description typed in the Asset Browser is kept")
+    document = object_document(obj)
     check(not assets.thumbnail_stale(obj) and len(obj.asset_data.tags) == len(tags), "updated, the same tags")
 
     # The find kept in a library file, appended (as a drop does) into a new file: still live.
