@@ -69,7 +69,6 @@ class DQJuliaPreferences(bpy.types.AddonPreferences):
                 text="This Blender has no OSL: the OSL volume is unavailable (bakes and preview work).", icon="INFO"
             )
 
-
     @staticmethod
     def draw_asset_library(context, layout):
         """The preset asset library: where it goes, whether it is registered, the button."""

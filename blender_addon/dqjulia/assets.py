@@ -203,7 +203,10 @@ def register_library(context, folder):
 
 
 class DQJULIA_OT_mark_asset(bpy.types.Operator):
-    """Mark the DQ Julia object as an asset, with its parameters and a thumbnail rendered by the library in the object's own look (again: update the thumbnail)"""
+    bl_description = (
+        "Mark the DQ Julia object as an asset, with its parameters and a thumbnail the library renders "
+        "in the object's own look (again: update the thumbnail)"
+    )
 
     bl_idname = "dqjulia.mark_asset"
     bl_label = "Mark as Asset"
@@ -228,7 +231,10 @@ class DQJULIA_OT_mark_asset(bpy.types.Operator):
 
 
 class DQJULIA_OT_preset_library(bpy.types.Operator):
-    """Write the shipped presets and the paper's figures as assets, with the library's thumbnails, into your user folder and add it to the asset libraries as "DQ Julia\""""
+    bl_description = (
+        "Write the shipped presets and the paper's figures as assets, with the library's thumbnails, "
+        'into your user folder and add it to the asset libraries as "DQ Julia"'
+    )
 
     bl_idname = "dqjulia.preset_library"
     bl_label = "Add Preset Asset Library"

@@ -174,7 +174,9 @@ def _asset_row(layout, obj):
 def menu_mark_asset(self, context):
     """In Blender's own asset menus: Mark as Asset with the library's thumbnail."""
     if operators.dqjulia_object(context) is not None:
-        self.layout.operator(assets.DQJULIA_OT_mark_asset.bl_idname, text="Mark as DQ Julia Asset", icon="ASSET_MANAGER")
+        self.layout.operator(
+            assets.DQJULIA_OT_mark_asset.bl_idname, text="Mark as DQ Julia Asset", icon="ASSET_MANAGER"
+        )
 
 
 # Blender's asset menus that get the item above, where this Blender has them.
