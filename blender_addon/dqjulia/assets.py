@@ -11,7 +11,8 @@ same way. No GPU and never Blender's generic icon: Blender keeps a preview set f
 own properties (Object.dqjulia), which an append or a drop from the Asset Browser carries: the
 dropped object is a DQ Julia object like any other (preview, bakes, variations). The asset's
 custom property THUMBNAIL_OF keeps the values its preview shows, so the panel can tell when the
-object changed since (Update Thumbnail).
+object changed since (Update Thumbnail). Blender's own Mark as Asset gives an empty no preview:
+a timer (give_thumbnails()) gives a DQ Julia asset without THUMBNAIL_OF the library's thumbnail.
 
 The preset library (write_preset_library(), register_library()): every preset the add-on ships
 (the examples and the paper's figures) made an asset in one .blend, LIBRARY_FILE, written by
@@ -105,6 +106,40 @@ def mark(obj, tags=()):
     preview.image_pixels = jobs.preview_ints(image, PREVIEW_SIZE, PREVIEW_SIZE)
     preview.icon_size = (ICON_SIZE, ICON_SIZE)
     preview.icon_pixels = jobs.preview_ints(icon, ICON_SIZE, ICON_SIZE)
+
+
+def give_thumbnails():
+    """DQ Julia objects made assets another way (Blender's own Mark as Asset, which gives an
+    empty no preview) get the library's thumbnail and metadata, as mark() gives them. Linked
+    objects are left alone; one whose thumbnail cannot be made is tried again only once its
+    values change. Returns how many were given one."""
+    given = 0
+    for obj in bpy.data.objects:
+        data = obj.asset_data
+        if data is None or obj.library is not None or data.get(THUMBNAIL_OF) is not None:
+            continue
+        settings = getattr(obj, "dqjulia", None)
+        if settings is None or not settings.enabled:
+            continue
+        values = values_text(obj)
+        if _failed.get(obj.name) == values:
+            continue
+        try:
+            mark(obj)
+            given += 1
+        except (ValueError, native.NativeError, native.NativeUnavailable):
+            _failed[obj.name] = values
+    return given
+
+
+_failed = {}  # object name -> the values whose thumbnail could not be made
+POLL_SECONDS = 1.0  # how often give_thumbnails() looks (a timer: Blender has no handler for marking)
+
+
+def _poll():
+    if native.load_error() is None:
+        give_thumbnails()
+    return POLL_SECONDS
 
 
 def thumbnail_stale(obj):
@@ -263,8 +298,13 @@ CLASSES = (DQJULIA_OT_mark_asset, DQJULIA_OT_preset_library)
 def register():
     for cls in CLASSES:
         bpy.utils.register_class(cls)
+    if not bpy.app.timers.is_registered(_poll):
+        bpy.app.timers.register(_poll, first_interval=POLL_SECONDS, persistent=True)
 
 
 def unregister():
+    if bpy.app.timers.is_registered(_poll):
+        bpy.app.timers.unregister(_poll)
+    _failed.clear()
     for cls in reversed(CLASSES):
         bpy.utils.unregister_class(cls)

@@ -21,7 +21,8 @@ folders the runner (run_blender.cmake) points BLENDER_USER_* at, then runs its c
                 thumbnail give a message in the panel
   presets       presets, import/export round trips of every example, a bad file; Mark as Asset: the
                 asset's metadata, its preview and icon exactly the library's renders, an update after an
-                edit, an empty slice refused; the asset saved and appended into a new file is a working
+                edit, an empty slice refused, one marked by Blender's own Mark as Asset given the
+                library's thumbnail; the asset saved and appended into a new file is a working
                 DQ Julia object (its parameters, preview state, Bake Mesh, variations); the preset asset
                 library written into the user's folder, registered once, the open file untouched
   slice         the Python slice against the core's
@@ -864,6 +865,23 @@ def check_assets():
     check(
         result == {"CANCELLED"} and "nothing to show" in error and empty.asset_data is None,
         "an empty slice is not marked: %s" % error[:110],
+    )
+    # Blender's own Mark as Asset (ID.asset_mark; an empty gets no preview): the add-on's timer
+    # gives the asset the library's thumbnail and metadata (give_thumbnails(), called here as it does).
+    empty.asset_mark()
+    other = new_dqjulia()
+    other.asset_mark()
+    check(bpy.app.timers.is_registered(assets._poll), "a timer looks for DQ Julia assets without a thumbnail")
+    given = assets.give_thumbnails()
+    check(
+        given == 1 and other.asset_data.get(assets.THUMBNAIL_OF) == assets.values_text(other),
+        "one marked by Blender's own Mark as Asset gets the library's thumbnail (%d given)" % given,
+    )
+    check("DQ Julia" in [tag.name for tag in other.asset_data.tags], "and the tags")
+    check_asset_preview(other, object_document(other), "marked by Blender's Mark as Asset")
+    check(
+        assets.give_thumbnails() == 0 and empty.asset_data.get(assets.THUMBNAIL_OF) is None,
+        "an empty slice marked that way keeps no thumbnail and is not tried again",
     )
     obj = new_dqjulia("paper-teaser")
     make_active(obj)
