@@ -170,15 +170,19 @@ def _remove(objects):
             bpy.data.actions.remove(action)
 
 
-def write_preset_library(folder):
+def write_preset_library(folder, on_progress=None):
     """Writes every shipped preset as an asset into folder/LIBRARY_FILE (replacing it whole, never
     half-written). Returns (path, the presets written, [(a preset left out, why)]). The objects
-    are made in the open file for the writing only and removed after: it is left as it was."""
+    are made in the open file for the writing only and removed after: it is left as it was.
+    on_progress(fraction) is called after each preset."""
     made, left_out = [], []
     path = os.path.join(folder, LIBRARY_FILE)
     temporary = path + ".partial"  # not a .blend: the Asset Browser never lists a half-written file
+    names = operators.preset_names()
     try:
-        for name in operators.preset_names():
+        for index, name in enumerate(names):
+            if on_progress is not None:
+                on_progress(index / len(names))
             try:
                 obj = operators.new_object(name, os.path.join(operators.PRESET_DIR, name + ".json"))
             except (native.NativeError, OSError) as error:
@@ -194,7 +198,7 @@ def write_preset_library(folder):
             raise ValueError("no preset could be made an asset: %s" % "; ".join("%s: %s" % item for item in left_out))
         written = sorted(obj.name for obj in assets)
         os.makedirs(folder, exist_ok=True)
-        bpy.data.libraries.write(temporary, set(assets), fake_user=True)
+        bpy.data.libraries.write(temporary, set(assets), fake_user=True, compress=True)
         os.replace(temporary, path)
     finally:
         _remove(made)
@@ -278,13 +282,17 @@ class DQJULIA_OT_preset_library(bpy.types.Operator):
         if native.load_error() is not None:
             self.report({"ERROR"}, native.load_error())
             return {"CANCELLED"}
+        wm = context.window_manager
+        wm.progress_begin(0.0, 1.0)  # the cursor shows it: a few seconds, one render a preset
         try:
             folder = library_folder()
-            path, written, left_out = write_preset_library(folder)
+            path, written, left_out = write_preset_library(folder, wm.progress_update)
             library = register_library(context, folder)
         except (ValueError, OSError, RuntimeError, native.NativeError, native.NativeUnavailable) as error:
             self.report({"ERROR"}, "The preset asset library was not made: %s" % error)
             return {"CANCELLED"}
+        finally:
+            wm.progress_end()
         message = '%d presets in the asset library "%s" (%s)' % (len(written), library.name, path)
         if left_out:
             message += "; left out: %s" % "; ".join("%s (%s)" % item for item in left_out)

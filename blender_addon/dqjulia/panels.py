@@ -66,6 +66,8 @@ class DQJULIA_MT_presets(bpy.types.Menu):
         layout = self.layout
         for name in operators.preset_names():
             layout.operator(operators.DQJULIA_OT_load_preset.bl_idname, text=name).preset = name
+        layout.separator()
+        layout.operator(assets.DQJULIA_OT_preset_library.bl_idname, icon="ASSET_MANAGER")
 
 
 class DQJULIA_UL_rotations(bpy.types.UIList):
