@@ -173,9 +173,10 @@ def _remove(objects):
 def write_preset_library(folder, on_progress=None):
     """Writes every shipped preset as an asset into folder/LIBRARY_FILE (replacing it whole, never
     half-written). Returns (path, the presets written, [(a preset left out, why)]). The objects
-    are made in the open file for the writing only and removed after: it is left as it was.
+    are made in the open file for the writing only and removed after: it is left as it was (an
+    object of it that has a preset's name lends it for the while, so the asset has that name).
     on_progress(fraction) is called after each preset."""
-    made, left_out = [], []
+    made, left_out, aside = [], [], {}  # aside: the open file's objects renamed for the while
     path = os.path.join(folder, LIBRARY_FILE)
     temporary = path + ".partial"  # not a .blend: the Asset Browser never lists a half-written file
     names = operators.preset_names()
@@ -189,9 +190,14 @@ def write_preset_library(folder, on_progress=None):
                 left_out.append((name, str(error)))
                 continue
             made.append(obj)
+            if obj.name != name:  # an object of the open file has the preset's name: lend it
+                other = next(o for o in bpy.data.objects if o.name == name and o.library is None)
+                other.name = "dqjulia-aside-%d" % index
+                aside[other] = name
+                obj.name = name
             try:
                 mark(obj, tags=("paper figure" if name.startswith("paper-") else "preset",))
-            except ValueError as error:
+            except (ValueError, native.NativeError) as error:
                 left_out.append((name, str(error)))
         assets = [obj for obj in made if obj.asset_data is not None]
         if not assets:
@@ -202,6 +208,8 @@ def write_preset_library(folder, on_progress=None):
         os.replace(temporary, path)
     finally:
         _remove(made)
+        for other, name in aside.items():
+            other.name = name
         if os.path.exists(temporary):
             os.remove(temporary)
     return path, written, left_out

@@ -949,7 +949,10 @@ def check_assets():
         "its variations come (%s)" % (grid.summary if grid else ""),
     )
 
-    # The preset library: written into the user's folder, registered once, the open file untouched.
+    # The preset library: written into the user's folder, registered once, the open file untouched
+    # (an object of it named as a preset keeps its name, and the preset's asset has that name too).
+    mine = bpy.data.objects.new("paper-highres", None)
+    bpy.context.collection.objects.link(mine)
     before = (sorted(bpy.data.objects.keys()), len(bpy.data.actions))
     libraries = bpy.context.preferences.filepaths.asset_libraries
     count = len(libraries)
@@ -975,6 +978,7 @@ def check_assets():
         (sorted(bpy.data.objects.keys()), len(bpy.data.actions)) == before,
         "the open file's objects and actions are as they were",
     )
+    check(mine.name == "paper-highres" and not mine.dqjulia.enabled, "its own paper-highres is its own still")
     presets = operators_module().preset_names()
     shown = []
     for preset in presets:
