@@ -7,8 +7,8 @@ parameters on the object and the parameter file's JSON), slicing.py (the slice's
 animation.py (keyframes), core_state.py (what the core says about each object's parameters:
 the state the other modules share), preview.py (the GLSL preview), jobs.py (work in a thread),
 bakes.py (cache folder, objects from bakes), operators.py, variations.py (the Variations grid,
-its thumbnails and picks), assets.py (Mark as Asset, the preset asset library), farm.py (farm tasks' bakes), panels.py,
-osl.py, shaders/.
+its thumbnails and picks), assets.py (Mark as Asset, the preset asset library), farm.py (farm
+tasks' bakes), panels.py, osl.py, shaders/.
 """
 
 bl_info = {
