@@ -7,8 +7,8 @@ parameters on the object and the parameter file's JSON), slicing.py (the slice's
 animation.py (keyframes), core_state.py (what the core says about each object's parameters:
 the state the other modules share), preview.py (the GLSL preview), jobs.py (work in a thread),
 bakes.py (cache folder, objects from bakes), operators.py, variations.py (the Variations grid,
-its thumbnails and picks), farm.py (farm tasks' bakes), panels.py,
-osl.py, shaders/.
+its thumbnails and picks), assets.py (Mark as Asset, the preset asset library), farm.py (farm
+tasks' bakes), panels.py, osl.py, shaders/.
 """
 
 bl_info = {
@@ -22,10 +22,12 @@ bl_info = {
     "doc_url": "",
 }
 
+import os
+
 import bpy
 from bpy.props import StringProperty
 
-from . import bakes, core_state, farm, jobs, native, operators, osl, panels, preview, props, variations
+from . import assets, bakes, core_state, farm, jobs, native, operators, osl, panels, preview, props, variations
 
 
 class DQJuliaPreferences(bpy.types.AddonPreferences):
@@ -51,6 +53,7 @@ class DQJuliaPreferences(bpy.types.AddonPreferences):
             )
             if bpy.data.filepath:
                 layout.label(text=str(error), icon="ERROR")
+        self.draw_asset_library(context, layout)
         error = native.load_error()
         if error is None:
             layout.label(
@@ -66,6 +69,27 @@ class DQJuliaPreferences(bpy.types.AddonPreferences):
                 text="This Blender has no OSL: the OSL volume is unavailable (bakes and preview work).", icon="INFO"
             )
 
+    @staticmethod
+    def draw_asset_library(context, layout):
+        """The preset asset library: where it goes, whether it is registered, the button."""
+        box = layout.box()
+        try:
+            folder = assets.library_folder(create=False)
+        except (OSError, ValueError) as error:
+            box.label(text="Preset asset library: no user folder (%s)" % error, icon="ERROR")
+            return
+        library = assets.registered_library(context, folder)
+        exists = os.path.isfile(os.path.join(folder, assets.LIBRARY_FILE))
+        if library is not None and exists:
+            box.label(text='Preset assets: the asset library "%s" (%s)' % (library.name, folder), icon="ASSET_MANAGER")
+        else:
+            box.label(
+                text="The presets and the paper's figures as assets with thumbnails, in %s" % folder,
+                icon="ASSET_MANAGER",
+            )
+        label = "Update Preset Asset Library" if library is not None and exists else "Add Preset Asset Library"
+        box.operator(assets.DQJULIA_OT_preset_library.bl_idname, text=label)
+
 
 def register():
     bpy.utils.register_class(DQJuliaPreferences)
@@ -73,6 +97,7 @@ def register():
     core_state.register()
     operators.register()
     variations.register()
+    assets.register()
     farm.register()
     panels.register()
     osl.register()
@@ -89,6 +114,7 @@ def unregister():
     osl.unregister()
     panels.unregister()
     farm.unregister()
+    assets.unregister()
     variations.unregister()
     operators.unregister()
     core_state.unregister()

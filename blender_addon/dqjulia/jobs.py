@@ -124,6 +124,36 @@ class MeshTask(_TaskBase):
 THUMBNAIL_SIZE = 128  # pixels, square: a variation's picture in the grid
 
 
+def render_thumbnail(
+    context: native.Context, document: Dict[str, Any], size: int, progress: Optional[native.Progress] = None
+) -> Tuple[Optional[bytes], str]:
+    """A document's picture as the core renders it in the document's own look (its material,
+    palette and lights; one sample a pixel), `size` pixels square, RGBA8 sRGB, rows top-down:
+    (pixels, "") or (None, why). A cancel is raised, any other failure kept. The Variations
+    grid's thumbnails and the assets' previews (assets.py) are these."""
+    document = dict(document)
+    document["render"] = dict(document.get("render") or {}, samples=1)
+    try:
+        context.set_params(document)
+        pixels, _warning = context.render_rgba8(size, size, progress)
+        return pixels, ""
+    except native.NativeError as error:
+        if error.cancelled or (progress is not None and progress.cancelled):
+            raise
+        return None, error.message
+    except native.NativeUnavailable as error:
+        return None, str(error)
+
+
+def preview_ints(pixels: bytes, width: int, height: int) -> array.array[int]:
+    """The core's RGBA8 rows (top-down) as Blender's ImagePreview.image_pixels (or icon_pixels)
+    take them: one int a pixel (its four bytes), rows bottom-up."""
+    stride = 4 * width
+    packed: array.array[int] = array.array("i")
+    packed.frombytes(b"".join(pixels[stride * row : stride * (row + 1)] for row in range(height - 1, -1, -1)))
+    return packed
+
+
 class Thumbnail:
     """One slot of a grid of variations, filled by the worker: the variation's complete document
     (JSON text, as the core gives it), then its picture (RGBA8, sRGB, rows top-down) or why it
@@ -175,25 +205,9 @@ class VariationsTask(_TaskBase):
         for index, text in enumerate(texts):
             self.part = (self.COMPUTE_SHARE + index * share, share)
             slot = Thumbnail(index, text, str(described[index].get("description", "")))
-            slot.pixels, slot.error = self.thumbnail(context, text, progress)
+            slot.pixels, slot.error = render_thumbnail(context, json.loads(text), THUMBNAIL_SIZE, progress)
             self.thumbnails.append(slot)
         return self.thumbnails
-
-    @staticmethod
-    def thumbnail(context: native.Context, text: str, progress: native.Progress) -> Tuple[Optional[bytes], str]:
-        """(pixels, "") or (None, why): a cancel is raised, any other failure kept."""
-        document = json.loads(text)
-        document.setdefault("render", {})["samples"] = 1
-        try:
-            context.set_params(document)
-            pixels, _warning = context.render_rgba8(THUMBNAIL_SIZE, THUMBNAIL_SIZE, progress)
-            return pixels, ""
-        except native.NativeError as error:
-            if error.cancelled or progress.cancelled:
-                raise
-            return None, error.message
-        except native.NativeUnavailable as error:
-            return None, str(error)
 
 
 # One task of a Job: native calls with a document.

@@ -123,6 +123,32 @@ class _NeedsDQJuliaObject:
 SLICE_TO_BLENDER_ROTATION = (math.pi / 2.0, 0.0, 0.0)
 
 
+def new_object(name, path=""):
+    """A new DQ Julia object (an empty showing the set's bounds, turned so the slice's y is up),
+    in no collection yet: the parameter file at `path`, or the core's defaults. Raises
+    native.NativeError (a bad file, with the core's message) or OSError, leaving nothing."""
+    obj = bpy.data.objects.new(name, None)
+    obj.empty_display_type = "SPHERE"
+    obj.rotation_euler = SLICE_TO_BLENDER_ROTATION
+    try:
+        obj.dqjulia.enabled = True
+        if path:
+            load_params_into(obj, path)
+        else:
+            with native.Context() as native_context:  # the core's defaults, so they never drift
+                props.from_document(obj.dqjulia, native_context.params())
+    except BaseException:
+        action = obj.animation_data.action if obj.animation_data else None
+        bpy.data.objects.remove(obj)
+        if action is not None and action.users == 0:
+            bpy.data.actions.remove(action)
+        raise
+    state = core_state.state_for(obj)
+    if state.bounds is not None:
+        obj.empty_display_size = state.bounds[1]
+    return obj
+
+
 class DQJULIA_OT_add(bpy.types.Operator):
     """Add a DQ Julia object: the set ray-marched in the viewport inside its bounds"""
 
@@ -137,26 +163,16 @@ class DQJULIA_OT_add(bpy.types.Operator):
             return {"CANCELLED"}
         if context.mode != "OBJECT" and bpy.ops.object.mode_set.poll():
             bpy.ops.object.mode_set(mode="OBJECT")
-        obj = bpy.data.objects.new("DQ Julia", None)
-        obj.empty_display_type = "SPHERE"
-        obj.location = context.scene.cursor.location
-        obj.rotation_euler = SLICE_TO_BLENDER_ROTATION
-        context.collection.objects.link(obj)
         try:
-            obj.dqjulia.enabled = True
+            path = ""
             if self.preset:
                 path = self.preset if os.path.isfile(self.preset) else os.path.join(PRESET_DIR, self.preset + ".json")
-                load_params_into(obj, path)
-            else:
-                with native.Context() as native_context:  # the core's defaults, so they never drift
-                    props.from_document(obj.dqjulia, native_context.params())
+            obj = new_object("DQ Julia", path)
         except (native.NativeError, native.NativeUnavailable, OSError) as error:
-            bpy.data.objects.remove(obj)
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        state = core_state.state_for(obj)
-        if state.bounds is not None:
-            obj.empty_display_size = state.bounds[1]
+        obj.location = context.scene.cursor.location
+        context.collection.objects.link(obj)
         for other in context.selected_objects:
             other.select_set(False)
         obj.select_set(True)

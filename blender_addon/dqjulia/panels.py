@@ -8,7 +8,7 @@ import time
 
 import bpy
 
-from . import bakes, core_state, jobs, native, operators, osl, preview, props, variations
+from . import assets, bakes, core_state, jobs, native, operators, osl, preview, props, variations
 
 
 def _wrapped(layout, text, icon="NONE", alert=False, width=None):
@@ -66,6 +66,8 @@ class DQJULIA_MT_presets(bpy.types.Menu):
         layout = self.layout
         for name in operators.preset_names():
             layout.operator(operators.DQJULIA_OT_load_preset.bl_idname, text=name).preset = name
+        layout.separator()
+        layout.operator(assets.DQJULIA_OT_preset_library.bl_idname, icon="ASSET_MANAGER")
 
 
 class DQJULIA_UL_rotations(bpy.types.UIList):
@@ -120,6 +122,7 @@ class _MainPanel:
         row.menu(DQJULIA_MT_presets.bl_idname, icon="PRESET")
         row.operator(operators.DQJULIA_OT_import_params.bl_idname, text="", icon="IMPORT")
         row.operator(operators.DQJULIA_OT_export_params.bl_idname, text="", icon="EXPORT")
+        _asset_row(layout, obj)
 
         column = layout.column()
         column.prop(s, "variant")
@@ -156,6 +159,30 @@ class _MainPanel:
             row = layout.row()
             row.label(text=job.status_text(), icon="TIME")
             row.operator(operators.DQJULIA_OT_cancel_bakes.bl_idname, text="", icon="CANCEL")
+
+
+def _asset_row(layout, obj):
+    """Mark as Asset, or (an asset) whether its thumbnail still shows the object's values."""
+    if obj.asset_data is None:
+        layout.operator(assets.DQJULIA_OT_mark_asset.bl_idname, icon="ASSET_MANAGER")
+    elif assets.thumbnail_stale(obj):
+        row = layout.row(align=True)
+        row.label(text="Asset: its thumbnail shows earlier values", icon="ASSET_MANAGER")
+        row.operator(assets.DQJULIA_OT_mark_asset.bl_idname, text="Update", icon="FILE_REFRESH")
+    else:
+        layout.label(text="An asset (Asset Browser)", icon="ASSET_MANAGER")
+
+
+def menu_mark_asset(self, context):
+    """In Blender's own asset menus: Mark as Asset with the library's thumbnail."""
+    if operators.dqjulia_object(context) is not None:
+        self.layout.operator(
+            assets.DQJULIA_OT_mark_asset.bl_idname, text="Mark as DQ Julia Asset", icon="ASSET_MANAGER"
+        )
+
+
+# Blender's asset menus that get the item above, where this Blender has them.
+ASSET_MENUS = ("VIEW3D_MT_object_asset", "OUTLINER_MT_asset")
 
 
 class _SlicePanel(_Base):
@@ -450,8 +477,16 @@ CLASSES = [DQJULIA_MT_presets, DQJULIA_UL_rotations] + _make_panels()
 def register():
     for cls in CLASSES:
         bpy.utils.register_class(cls)
+    for name in ASSET_MENUS:
+        menu = getattr(bpy.types, name, None)
+        if menu is not None:
+            menu.append(menu_mark_asset)
 
 
 def unregister():
+    for name in ASSET_MENUS:
+        menu = getattr(bpy.types, name, None)
+        if menu is not None:
+            menu.remove(menu_mark_asset)
     for cls in reversed(CLASSES):
         bpy.utils.unregister_class(cls)

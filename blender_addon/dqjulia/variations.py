@@ -130,17 +130,9 @@ def _forget_previews(grid):
     grid.icons.clear()
 
 
-def flipped_rows(pixels, width, height):
-    """RGBA8 rows top-down (the core's) as rows bottom-up (Blender's images)."""
-    stride = 4 * width
-    return b"".join(pixels[stride * row : stride * (row + 1)] for row in range(height - 1, -1, -1))
-
-
 def fill_previews(grid):
     """Copies the thumbnails that arrived since the last call into image previews; returns
     how many it added. Main thread only."""
-    import array
-
     added = 0
     size = jobs.THUMBNAIL_SIZE
     for thumbnail in list(grid.thumbnails):
@@ -148,9 +140,7 @@ def fill_previews(grid):
             continue
         preview = _collection().new(grid.preview_name(thumbnail.index))
         preview.image_size = (size, size)
-        packed = array.array("i")
-        packed.frombytes(flipped_rows(thumbnail.pixels, size, size))  # each int one pixel's RGBA bytes
-        preview.image_pixels = packed
+        preview.image_pixels = jobs.preview_ints(thumbnail.pixels, size, size)
         grid.icons[thumbnail.index] = preview.icon_id
         added += 1
     return added

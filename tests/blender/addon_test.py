@@ -19,7 +19,12 @@ folders the runner (run_blender.cmake) points BLENDER_USER_* at, then runs its c
                 library's variations, a pick sets exactly its document in one undo step and becomes the
                 centre, Back and Forward, Apply to a copy keeps the original, bad input and a failing
                 thumbnail give a message in the panel
-  presets       presets, import/export round trips of every example, a bad file
+  presets       presets, import/export round trips of every example, a bad file; Mark as Asset: the
+                asset's metadata, its preview and icon exactly the library's renders, an update after an
+                edit, an empty slice refused, one marked by Blender's own Mark as Asset given the
+                library's thumbnail; the asset saved and appended into a new file is a working
+                DQ Julia object (its parameters, preview state, Bake Mesh, variations); the preset asset
+                library written into the user's folder, registered once, the open file untouched
   slice         the Python slice against the core's
   keyframes     keyframes <-> the file's "animation" (export, import, each frame's values)
   bake_volume   Bake Volume: object, grids, material, replacement of an earlier bake
@@ -822,6 +827,191 @@ def case_presets():
         result == {"CANCELLED"} and "did you mean" in error,
         "a bad file is refused with the core's message: %s" % error[:110],
     )
+    check_assets()
+
+
+def library_pixels(document, size):
+    """The library's render of a document as the assets' previews are made (one sample a pixel),
+    as ImagePreview pixels."""
+    document = json.loads(json.dumps(document))
+    document["render"]["samples"] = 1
+    with native.Context(document) as context:
+        pixels, _warning = context.render_rgba8(size, size)
+    return packed_rows_bottom_up(pixels, size)
+
+
+def check_asset_preview(obj, document, what):
+    """The object's asset preview and icon are exactly the library's renders of `document`."""
+    assets = common.submodule(dqjulia, "assets")
+    preview = obj.preview
+    for size, kind in ((assets.PREVIEW_SIZE, "image"), (assets.ICON_SIZE, "icon")):
+        pixels = list(getattr(preview, kind + "_pixels")) if preview is not None else []
+        check(
+            preview is not None
+            and tuple(getattr(preview, kind + "_size")) == (size, size)
+            and pixels == library_pixels(document, size),
+            "%s: its preview's %s is exactly the library's %dx%d render of its values" % (what, kind, size, size),
+        )
+
+
+def check_assets():
+    """Mark as Asset (its metadata, the library's thumbnail, a stale one updated, bad input), a
+    find saved and appended into a new file as a working DQ Julia object, and the preset library."""
+    assets = common.submodule(dqjulia, "assets")
+    clear_scene()
+    empty = new_dqjulia("paper-test2-1")
+    make_active(empty)
+    result, error = common.call(bpy.ops.dqjulia.mark_asset)
+    check(
+        result == {"CANCELLED"} and "nothing to show" in error and empty.asset_data is None,
+        "an empty slice is not marked: %s" % error[:110],
+    )
+    # Blender's own Mark as Asset (ID.asset_mark; an empty gets no preview): the add-on's timer
+    # gives the asset the library's thumbnail and metadata (give_thumbnails(), called here as it does).
+    empty.asset_mark()
+    other = new_dqjulia()
+    other.asset_mark()
+    check(bpy.app.timers.is_registered(assets._poll), "a timer looks for DQ Julia assets without a thumbnail")
+    given = assets.give_thumbnails()
+    check(
+        given == 1 and other.asset_data.get(assets.THUMBNAIL_OF) == assets.values_text(other),
+        "one marked by Blender's own Mark as Asset gets the library's thumbnail (%d given)" % given,
+    )
+    check("DQ Julia" in [tag.name for tag in other.asset_data.tags], "and the tags")
+    check_asset_preview(other, object_document(other), "marked by Blender's Mark as Asset")
+    check(
+        assets.give_thumbnails() == 0 and empty.asset_data.get(assets.THUMBNAIL_OF) is None,
+        "an empty slice marked that way keeps no thumbnail and is not tried again",
+    )
+    obj = new_dqjulia("paper-teaser")
+    make_active(obj)
+    document = object_document(obj)
+    result = bpy.ops.dqjulia.mark_asset()
+    data = obj.asset_data
+    tags = sorted(tag.name for tag in data.tags) if data is not None else []
+    variant = dict((name, label) for name, label, _help in props.VARIANT_ITEMS)[document["fractal"]["variant"]]
+    check(result == {"FINISHED"} and data is not None, "Mark as Asset makes the object an asset")
+    own = document.get("description")
+    check(
+        own and data is not None and data.description == own,
+        "its description is the parameters' own: %r" % (data.description[:60] if data else ""),
+    )
+    check("DQ Julia" in tags and variant in tags, "its tags: %s" % tags)
+    check_asset_preview(obj, document, "the asset")
+    check(not assets.thumbnail_stale(obj), "the thumbnail shows the object's values")
+    obj.dqjulia.iterations += 2
+    check(assets.thumbnail_stale(obj), "an edit makes it stale (the panel offers Update Thumbnail)")
+    bpy.ops.dqjulia.mark_asset()
+    document = object_document(obj)
+    check_asset_preview(obj, document, "marked again")
+    obj.dqjulia.description = ""
+    bpy.ops.dqjulia.mark_asset()
+    check(
+        obj.asset_data.description == assets.describe(document) and "iterations" in obj.asset_data.description,
+        "without one, a description of its values: %r" % obj.asset_data.description,
+    )
+    obj.asset_data.description = "a find of mine"
+    bpy.ops.dqjulia.mark_asset()
+    check(obj.asset_data.description == "a find of mine", "a description typed in the Asset Browser is kept")
+    document = object_document(obj)
+    check(not assets.thumbnail_stale(obj) and len(obj.asset_data.tags) == len(tags), "updated, the same tags")
+
+    # The find kept in a library file, appended (as a drop does) into a new file: still live.
+    library_blend = os.path.join(ARGS.work, "finds.blend")
+    name = obj.name
+    bpy.ops.wm.save_as_mainfile(filepath=library_blend)
+    bpy.ops.wm.read_homefile(use_empty=True)
+    check(name not in bpy.data.objects, "a new, empty file")
+    result = bpy.ops.wm.append(directory=library_blend + "/Object/", filename=name)
+    dropped = bpy.data.objects.get(name)
+    check(
+        result == {"FINISHED"} and dropped is not None and dropped.dqjulia.enabled and dropped.asset_data is not None,
+        "the asset appended into a new file is a DQ Julia object and an asset",
+    )
+    if dropped is None:
+        return
+    check(object_document(dropped) == document, "with exactly its parameters")
+    check_asset_preview(dropped, document, "appended")
+    make_active(dropped)
+    check(core_state.state_for(dropped).drawable, "the preview draws it (its state: bounds, not empty)")
+    dropped.dqjulia.bake_resolution = 32
+    result = bpy.ops.dqjulia.bake_mesh(synchronous=True)
+    mesh = baked_child(dropped, "mesh")
+    check(
+        result == {"FINISHED"} and mesh is not None and len(mesh.data.polygons) > 100,
+        "Bake Mesh works on it (%d faces)" % (len(mesh.data.polygons) if mesh else 0),
+    )
+    variations = common.submodule(dqjulia, "variations")
+    result = bpy.ops.dqjulia.variations_refresh(next_seed=False)
+    grid = variations.grid_for(dropped)
+    check(
+        result == {"FINISHED"} and grid is not None and len(grid.thumbnails) == variations.COUNT,
+        "its variations come (%s)" % (grid.summary if grid else ""),
+    )
+
+    # The preset library: written into the user's folder, registered once, the open file untouched
+    # (an object of it named as a preset keeps its name, and the preset's asset has that name too).
+    mine = bpy.data.objects.new("paper-highres", None)
+    bpy.context.collection.objects.link(mine)
+    before = (sorted(bpy.data.objects.keys()), len(bpy.data.actions))
+    libraries = bpy.context.preferences.filepaths.asset_libraries
+    count = len(libraries)
+    started = time.monotonic()
+    result = bpy.ops.dqjulia.preset_library()
+    seconds = time.monotonic() - started
+    result2 = bpy.ops.dqjulia.preset_library()  # again: the file replaced, the library not added twice
+    folder = assets.library_folder()
+    path = os.path.join(folder, assets.LIBRARY_FILE)
+    library = assets.registered_library(bpy.context, folder)
+    check(
+        result == result2 == {"FINISHED"} and os.path.isfile(path) and len(libraries) == count + 1,
+        "Add Preset Asset Library writes %s in %.1f s and registers it once" % (path, seconds),
+    )
+    check(library is not None and library.name == assets.LIBRARY_NAME, "as the asset library %r" % assets.LIBRARY_NAME)
+    check(
+        not os.path.abspath(path).startswith(os.path.abspath(ADDON_DIR))
+        and not os.path.exists(path + ".partial")
+        and not [name for name in os.listdir(folder) if name != assets.LIBRARY_FILE],
+        "in the user's folder, not the add-on's, and nothing else left there",
+    )
+    check(
+        (sorted(bpy.data.objects.keys()), len(bpy.data.actions)) == before,
+        "the open file's objects and actions are as they were",
+    )
+    check(mine.name == "paper-highres" and not mine.dqjulia.enabled, "its own paper-highres is its own still")
+    presets = operators_module().preset_names()
+    shown = []
+    for preset in presets:
+        state = core_state.state_for_document(core_document(os.path.join(EXAMPLES, preset + ".json")))
+        if state.drawable:
+            shown.append(preset)
+    with bpy.data.libraries.load(path, assets_only=True) as (source, _target):
+        in_file = sorted(source.objects)
+    check(
+        in_file == shown and len(shown) >= len(presets) - 2,
+        "the library holds every preset with something to see, as an asset (%d of %d)" % (len(in_file), len(presets)),
+    )
+    result = bpy.ops.wm.append(directory=path + "/Object/", filename="paper-teaser")
+    teaser = bpy.data.objects.get("paper-teaser")
+    expected = core_document(os.path.join(EXAMPLES, "paper-teaser.json"))
+    check(
+        result == {"FINISHED"} and teaser is not None and object_document(teaser) == object_document_of(expected),
+        "a preset appended from it holds the preset's parameters",
+    )
+    if teaser is not None:
+        tags = [tag.name for tag in teaser.asset_data.tags]
+        check("paper figure" in tags, "tagged as a paper figure: %s" % tags)
+        check_asset_preview(teaser, object_document(teaser), "the preset paper-teaser")
+
+
+def object_document_of(document):
+    """A document as an object holding it gives it back (the core's complete document)."""
+    obj = bpy.data.objects.new("scratch", None)
+    try:
+        props.from_document(obj.dqjulia, document)
+        return object_document(obj)
+    finally:
+        bpy.data.objects.remove(obj)
 
 
 def operators_module():
