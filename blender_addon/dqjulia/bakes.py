@@ -207,8 +207,9 @@ def volume_density(source):
 
 # The volume looks (props "volume_look"). "SURFACE": where the fog passes SURFACE_LEVEL (just inside
 # the set's edge: the fog ramps from 0 at the surface to 1 across the band's inner half), light
-# falls to e^-4 within SURFACE_VOXELS voxels of the bake, so the volume renders as an opaque, shaded surface like the mesh and `dqjulia render`; "CLOUD":
-# the fog as it is, at volume_density (a soft, translucent glow).
+# falls to e^-4 within SURFACE_VOXELS voxels of the bake, so the volume renders as an opaque,
+# shaded surface like the mesh and `dqjulia render`; "CLOUD": the fog as it is, at volume_density
+# (a soft, translucent glow).
 SURFACE_LEVEL = 0.02
 SURFACE_VOXELS = 1.0
 
@@ -217,6 +218,17 @@ def surface_density(source):
     """The "SURFACE" look's density scale: opaque within SURFACE_VOXELS of the bake's voxels."""
     voxel = bake_side(source) / max(1, source.dqjulia.bake_resolution)
     return VISIBLE_OPTICAL_DEPTH / max(1e-6, SURFACE_VOXELS * voxel)
+
+
+def _math_node(tree, operation, label, source, value, location):
+    """A Math node of `operation` on (the socket `source`, the constant `value`)."""
+    node = tree.nodes.new("ShaderNodeMath")
+    node.operation = operation
+    node.label = label
+    node.inputs[1].default_value = value
+    node.location = location
+    tree.links.new(source, node.inputs[0])
+    return node
 
 
 def volume_material(name, grid_names, density=10.0, colour=(0.5, 0.5, 0.5), ambient=0.15, surface_level=None):
@@ -257,18 +269,8 @@ def volume_material(name, grid_names, density=10.0, colour=(0.5, 0.5, 0.5), ambi
         # (an attribute name Cycles does not find multiplies by nothing), so the edge is sharp.
         if "Density Attribute" in volume.inputs:
             volume.inputs["Density Attribute"].default_value = ""
-        edge = tree.nodes.new("ShaderNodeMath")
-        edge.operation = "GREATER_THAN"
-        edge.label = "Surface edge"
-        edge.inputs[1].default_value = surface_level
-        edge.location = (-500, 0)
-        tree.links.new(fog.outputs["Fac"], edge.inputs[0])
-        scale = tree.nodes.new("ShaderNodeMath")
-        scale.operation = "MULTIPLY"
-        scale.label = "Surface density"
-        scale.inputs[1].default_value = density
-        scale.location = (-300, 0)
-        tree.links.new(edge.outputs["Value"], scale.inputs[0])
+        edge = _math_node(tree, "GREATER_THAN", "Surface edge", fog.outputs["Fac"], surface_level, (-500, 0))
+        scale = _math_node(tree, "MULTIPLY", "Surface density", edge.outputs["Value"], density, (-300, 0))
         tree.links.new(scale.outputs["Value"], volume.inputs["Density"])
         tree.links.new(scale.outputs["Value"], glow.inputs[0])
         glow.inputs[1].default_value = ambient

@@ -190,12 +190,8 @@ def studio(context, obj):
     return lights
 
 
-class _StudioOperator:
+class _StudioOperator(operators._NeedsDQJuliaObject):
     bl_options = {"REGISTER", "UNDO"}
-
-    @classmethod
-    def poll(cls, context):
-        return operators.dqjulia_object(context) is not None
 
     def execute(self, context):
         obj = operators.dqjulia_object(context)

@@ -1502,7 +1502,8 @@ def check_first_render(scene, obj):
     make_active(obj)
     for operator in (studio.DQJULIA_OT_frame_camera, studio.DQJULIA_OT_studio):
         check("UNDO" in operator.bl_options, "%s is undoable" % operator.bl_label)
-    result = bpy.ops.dqjulia.frame_camera()
+    with NoDeprecations("Frame Camera"):
+        result = bpy.ops.dqjulia.frame_camera()
     check(result == {"FINISHED"} and scene.camera == camera, "Frame Camera aims the scene's camera")
     center, radius = studio.world_bounds(obj)
     projected = world_to_camera_view(scene, camera, center)
@@ -1518,7 +1519,8 @@ def check_first_render(scene, obj):
         abs(distance - fitted) < 1e-4 * fitted, "as the core frames: the sphere fits with 8%% margin (%.4f)" % distance
     )
     light_before, world_before = (tuple(light.location), light.data.energy), tuple(world.color)
-    check(bpy.ops.dqjulia.studio() == {"FINISHED"}, "Studio")
+    with NoDeprecations("Studio"):
+        check(bpy.ops.dqjulia.studio() == {"FINISHED"}, "Studio")
     check(bpy.ops.dqjulia.studio() == {"FINISHED"}, "Studio again")
     tagged = [o for o in bpy.data.objects if o.get(studio.STUDIO_KEY)]
     check(
@@ -1562,8 +1564,8 @@ def check_first_render(scene, obj):
         check(
             after[kind][0] >= FIRST_RENDER_COVER * core_cover
             and after[kind][1] >= max(FIRST_RENDER_LUMINANCE, FIRST_RENDER_BRIGHTER * before[kind][1]),
-            "the %s covers >= %.2f times what `dqjulia render` covers, lit >= %.2f and >= %.2f times the default scene's"
-            % (kind, FIRST_RENDER_COVER, FIRST_RENDER_LUMINANCE, FIRST_RENDER_BRIGHTER),
+            "the %s covers >= %.2f times what `dqjulia render` covers, lit >= %.2f and >= %.2f times the default "
+            "scene's" % (kind, FIRST_RENDER_COVER, FIRST_RENDER_LUMINANCE, FIRST_RENDER_BRIGHTER),
         )
 
     material = volume.data.materials[0]
@@ -1591,6 +1593,20 @@ def check_first_render(scene, obj):
     )
     fov = math.degrees(scene.camera.data.angle_y)
     check(abs(fov - 40.0) < 1e-3, "with the document's field of view (%.3f degrees)" % fov)
+    placed = scene.camera.matrix_world.copy()
+    objects_before = set(bpy.data.objects.keys())
+    obj.dqjulia.bailout = 1.2  # invalid: nothing to frame or light
+    for operator in (bpy.ops.dqjulia.frame_camera, bpy.ops.dqjulia.studio):
+        result, error = common.call(operator)
+        check(
+            result == {"CANCELLED"} and "bailout" in error,
+            "invalid parameters: %s says why: %s" % (operator.idname_py(), error[:100]),
+        )
+    check(
+        scene.camera.matrix_world == placed and set(bpy.data.objects.keys()) == objects_before,
+        "and changes nothing",
+    )
+    obj.dqjulia.bailout = 4.0
 
 
 def case_osl():
