@@ -36,8 +36,8 @@ folders the runner (run_blender.cmake) points BLENDER_USER_* at, then runs its c
   cancel        cancelled and failed bakes leave nothing; a threaded bake leaves Python running
   render        Cycles renders the baked volume and the baked mesh: same silhouette (IoU); the first
                 render: F12 in the default scene, then Frame Camera and Studio (the set's share of the
-                frame and its luminance, stated), Studio twice, the user's light and world untouched,
-                the surface and the cloud look
+                frame and its luminance, stated), Studio twice, the user's light and world untouched, undo,
+                invalid parameters refused, the surface and the cloud look
   osl           Add OSL Volume: with OSL, its Cycles render matches the baked volume's (IoU);
                 without, it says why
   disable       the add-on unregisters cleanly
@@ -1607,6 +1607,24 @@ def check_first_render(scene, obj):
         "and changes nothing",
     )
     obj.dqjulia.bailout = 4.0
+
+    # Undo: each is one step (True: as a click, undoable; background mode starts without a stack).
+    user_world = world.name
+    scene.world = world
+    for old in [o for o in scene.objects if o.type == "CAMERA"]:
+        bpy.data.objects.remove(old)
+    make_active(obj)
+    bpy.ops.ed.undo_push(message="before Frame Camera and Studio")
+    check(bpy.ops.dqjulia.frame_camera("EXEC_DEFAULT", True) == {"FINISHED"}, "Frame Camera (undoable)")
+    check(bpy.ops.dqjulia.studio("EXEC_DEFAULT", True) == {"FINISHED"}, "Studio (undoable)")
+    check(bpy.context.scene.world.name != user_world, "the scene uses the studio's world")
+    bpy.ops.ed.undo()
+    check(bpy.context.scene.world.name == user_world, "one undo gives the scene its own world again")
+    bpy.ops.ed.undo()
+    check(
+        bpy.context.scene.camera is None and not [o for o in bpy.data.objects if o.type == "CAMERA"],
+        "and another removes the camera Frame Camera made",
+    )
 
 
 def case_osl():
