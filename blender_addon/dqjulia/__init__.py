@@ -8,7 +8,8 @@ animation.py (keyframes), core_state.py (what the core says about each object's 
 the state the other modules share), preview.py (the GLSL preview), jobs.py (work in a thread),
 bakes.py (cache folder, objects from bakes), operators.py, variations.py (the Variations grid,
 its thumbnails and picks), assets.py (Mark as Asset, the preset asset library), farm.py (farm
-tasks' bakes), panels.py, osl.py, shaders/.
+tasks' bakes), studio.py (Frame Camera and Studio: a first render that shows the set),
+panels.py, osl.py, shaders/.
 """
 
 bl_info = {
@@ -27,7 +28,21 @@ import os
 import bpy
 from bpy.props import StringProperty
 
-from . import assets, bakes, core_state, farm, jobs, native, operators, osl, panels, preview, props, variations
+from . import (
+    assets,
+    bakes,
+    core_state,
+    farm,
+    jobs,
+    native,
+    operators,
+    osl,
+    panels,
+    preview,
+    props,
+    studio,
+    variations,
+)
 
 
 class DQJuliaPreferences(bpy.types.AddonPreferences):
@@ -99,6 +114,7 @@ def register():
     variations.register()
     assets.register()
     farm.register()
+    studio.register()
     panels.register()
     osl.register()
     preview.register()
@@ -113,6 +129,7 @@ def unregister():
     preview.unregister()
     osl.unregister()
     panels.unregister()
+    studio.unregister()
     farm.unregister()
     assets.unregister()
     variations.unregister()

@@ -188,24 +188,56 @@ def principled_volume_material(name):
     return material, volume
 
 
-def volume_density(source):
-    """The density scale of a DQ Julia object's volume material (and its OSL volume's): the fog
-    is 0..1; this makes light fall to e^-4 within bake.color_depth of the bake's side."""
+def bake_side(source):
+    """The longest side of the object's bake box (its bounding sphere's diameter when automatic)."""
     s = source.dqjulia
     if s.bake_bounds_auto:
         bounds = core_state.state_for(source).bounds
         side = 2.0 * (bounds[1] if bounds else 1.0)
     else:
         side = max(high - low for low, high in zip(s.bake_bounds_min, s.bake_bounds_max))
-    return VISIBLE_OPTICAL_DEPTH / max(1e-6, s.bake_color_depth * side)
+    return side
 
 
-def volume_material(name, grid_names, density=10.0, colour=(0.5, 0.5, 0.5), ambient=0.15):
+def volume_density(source):
+    """The density scale of a DQ Julia object's volume material (and its OSL volume's): the fog
+    is 0..1; this makes light fall to e^-4 within bake.color_depth of the bake's side."""
+    return VISIBLE_OPTICAL_DEPTH / max(1e-6, source.dqjulia.bake_color_depth * bake_side(source))
+
+
+# The volume looks (props "volume_look"). "SURFACE": where the fog passes SURFACE_LEVEL (just inside
+# the set's edge: the fog ramps from 0 at the surface to 1 across the band's inner half), light
+# falls to e^-4 within SURFACE_VOXELS voxels of the bake, so the volume renders as an opaque,
+# shaded surface like the mesh and `dqjulia render`; "CLOUD": the fog as it is, at volume_density
+# (a soft, translucent glow).
+SURFACE_LEVEL = 0.02
+SURFACE_VOXELS = 1.0
+
+
+def surface_density(source):
+    """The "SURFACE" look's density scale: opaque within SURFACE_VOXELS of the bake's voxels."""
+    voxel = bake_side(source) / max(1, source.dqjulia.bake_resolution)
+    return VISIBLE_OPTICAL_DEPTH / max(1e-6, SURFACE_VOXELS * voxel)
+
+
+def _math_node(tree, operation, label, source, value, location):
+    """A Math node of `operation` on (the socket `source`, the constant `value`)."""
+    node = tree.nodes.new("ShaderNodeMath")
+    node.operation = operation
+    node.label = label
+    node.inputs[1].default_value = value
+    node.location = location
+    tree.links.new(source, node.inputs[0])
+    return node
+
+
+def volume_material(name, grid_names, density=10.0, colour=(0.5, 0.5, 0.5), ambient=0.15, surface_level=None):
     """A Principled Volume: the "density" grid times `density`, coloured by the "color" grid when
     there is one (else the flat `colour`), which is also its scattering albedo. A dense volume
     lit by one light scatters about a sixth of what a surface of its colour reflects, so it also
     glows with `ambient` times its colour where it is dense (the emission is per unit of density:
-    a thick part shows ambient * colour), as the preview's and the renderer's ambient term does."""
+    a thick part shows ambient * colour), as the preview's and the renderer's ambient term does.
+    With `surface_level`, only fog above that level is dense (the "SURFACE" look: a hard edge)."""
     material, volume = principled_volume_material(name)
     tree = material.node_tree
     volume.inputs["Density"].default_value = density
@@ -224,15 +256,50 @@ def volume_material(name, grid_names, density=10.0, colour=(0.5, 0.5, 0.5), ambi
         volume.inputs["Emission Color"].default_value = list(colour) + [1.0]
     fog = tree.nodes.new("ShaderNodeAttribute")
     fog.attribute_name = "density"
-    fog.location = (-500, -150)
+    fog.location = (-700, -150)
     glow = tree.nodes.new("ShaderNodeMath")
     glow.operation = "MULTIPLY"
     glow.label = "Ambient glow"
-    glow.inputs[1].default_value = ambient * density
     glow.location = (-300, -150)
-    tree.links.new(fog.outputs["Fac"], glow.inputs[0])
+    if surface_level is None:
+        tree.links.new(fog.outputs["Fac"], glow.inputs[0])
+        glow.inputs[1].default_value = ambient * density
+    else:
+        # The density is `density` where the fog exceeds the level, else 0: not the fog times it
+        # (an attribute name Cycles does not find multiplies by nothing), so the edge is sharp.
+        if "Density Attribute" in volume.inputs:
+            volume.inputs["Density Attribute"].default_value = ""
+        edge = _math_node(tree, "GREATER_THAN", "Surface edge", fog.outputs["Fac"], surface_level, (-500, 0))
+        scale = _math_node(tree, "MULTIPLY", "Surface density", edge.outputs["Value"], density, (-300, 0))
+        tree.links.new(scale.outputs["Value"], volume.inputs["Density"])
+        tree.links.new(scale.outputs["Value"], glow.inputs[0])
+        glow.inputs[1].default_value = ambient
     tree.links.new(glow.outputs["Value"], volume.inputs["Emission Strength"])
     return material
+
+
+def look_material(source, name, grid_names):
+    """The volume material of a DQ Julia object's bake in the object's chosen look."""
+    s = source.dqjulia
+    if s.volume_look == "CLOUD":
+        return volume_material(name, grid_names, volume_density(source), tuple(s.color), s.ambient)
+    return volume_material(
+        name, grid_names, surface_density(source), tuple(s.color), s.ambient, surface_level=SURFACE_LEVEL
+    )
+
+
+def apply_volume_look(source):
+    """Gives the object's baked volumes (and sequences) a new material in its chosen look."""
+    for child in source.children:
+        if child.get(BAKE_KIND) not in ("volume", "sequence") or child.type != "VOLUME":
+            continue
+        names = [grid.name for grid in child.data.grids] if child.data.grids.load() else ["density"]
+        old = list(child.data.materials)
+        child.data.materials.clear()
+        child.data.materials.append(look_material(source, child.data.name, names))
+        for material in old:
+            if material is not None and material.users == 0:
+                bpy.data.materials.remove(material)
 
 
 def grid_names(path):
@@ -269,8 +336,7 @@ def build_volume(context, source, path, sequence=None):
             volume.frame_duration = count
             volume.frame_offset = first - 1
             volume.sequence_mode = "CLIP"
-        s = source.dqjulia
-        material = volume_material(name, names, volume_density(source), tuple(s.color), s.ambient)
+        material = look_material(source, name, names)
         volume.materials.append(material)
         files = [sequence[2]] if sequence else [path]
         return _replace(context, source, kind, name, volume, files)

@@ -8,7 +8,7 @@ import time
 
 import bpy
 
-from . import assets, bakes, core_state, jobs, native, operators, osl, preview, props, variations
+from . import assets, bakes, core_state, jobs, native, operators, osl, preview, props, studio, variations
 
 
 def _wrapped(layout, text, icon="NONE", alert=False, width=None):
@@ -391,6 +391,10 @@ class _BakePanel(_Base):
             row.label(text=job.status_text(), icon="TIME")
             row.operator(operators.DQJULIA_OT_cancel_bakes.bl_idname, text="Cancel", icon="CANCEL")
         layout.label(text="Esc cancels a running bake.", icon="INFO")
+        layout.prop(s, "volume_look", expand=True)
+        row = layout.row(align=True)  # the first render: the camera on the set, lights that show its form
+        row.operator(studio.DQJULIA_OT_frame_camera.bl_idname, icon="CAMERA_DATA")
+        row.operator(studio.DQJULIA_OT_studio.bl_idname, icon="LIGHT_SUN")
 
 
 class _OslPanel(_Base):

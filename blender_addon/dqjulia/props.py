@@ -241,6 +241,18 @@ DQJLight = _group(
 )
 DQJColor = _group("DQJColor", "A palette colour (material.palette[]).", {"color": make_property("material.palette[]")})
 
+VOLUME_LOOK_ITEMS = [
+    ("SURFACE", "Surface", "An opaque, shaded surface at the set's edge, as `dqjulia render` and the mesh show it"),
+    ("CLOUD", "Cloud", "The fog as baked: a soft, translucent glow"),
+]
+
+
+def _volume_look_changed(settings, _context):
+    from . import bakes  # bakes imports core_state, which imports this module
+
+    bakes.apply_volume_look(settings.id_data)
+
+
 _axes = FIELDS["slice.axes"]["default"].split(",")
 _settings = {
     "enabled": BoolProperty(
@@ -288,6 +300,15 @@ _settings = {
         soft_max=8.0,
         update=_redraw,
         description="Hit threshold in pixels for the preview",
+    ),
+    # how a baked volume renders (not in the file; bakes.py)
+    "volume_look": EnumProperty(
+        name="Volume look",
+        items=VOLUME_LOOK_ITEMS,
+        default="SURFACE",
+        update=_volume_look_changed,
+        description="How baked volumes render: an opaque, shaded surface, as `dqjulia render` and the mesh show it, "
+        "or the soft, translucent cloud of the fog",
     ),
     # the Variations panel's settings (not in the file; variations.py)
     "variation_strength": FloatProperty(

@@ -34,7 +34,10 @@ folders the runner (run_blender.cmake) points BLENDER_USER_* at, then runs its c
                 (Debian's Blender: the real `blender -b scene.blend --python-expr` command); finished frames
                 are skipped; attach adds the sequence and saves the .blend
   cancel        cancelled and failed bakes leave nothing; a threaded bake leaves Python running
-  render        Cycles renders the baked volume and the baked mesh: same silhouette (IoU)
+  render        Cycles renders the baked volume and the baked mesh: same silhouette (IoU); the first
+                render: F12 in the default scene, then Frame Camera and Studio (the set's share of the
+                frame and its luminance, stated), Studio twice, the user's light and world untouched, undo,
+                invalid parameters refused, the surface and the cloud look
   osl           Add OSL Volume: with OSL, its Cycles render matches the baked volume's (IoU);
                 without, it says why
   disable       the add-on unregisters cleanly
@@ -46,6 +49,7 @@ never run, so the threaded path is exercised through jobs.Job directly (case can
 import array
 import io
 import json
+import math
 import os
 import shutil
 import subprocess
@@ -242,11 +246,13 @@ def camera_on(scene, obj):
     return camera
 
 
-def render_alpha(scene, shown, name):
-    """Renders with only the objects in `shown` visible; returns (alpha values, seconds)."""
+def render_rgba(scene, shown, name, size=RENDER_SIZE):
+    """Renders at `size` with only the objects in `shown` visible; returns (RGBA values as
+    saved in the PNG, seconds)."""
     for obj in scene.objects:
         if obj.type in {"MESH", "VOLUME", "EMPTY"}:
             obj.hide_render = obj not in shown
+    scene.render.resolution_x, scene.render.resolution_y = size
     path = os.path.join(ARGS.work, "render-%s.png" % name)
     scene.render.filepath = path
     started = time.monotonic()
@@ -256,9 +262,15 @@ def render_alpha(scene, shown, name):
     image = bpy.data.images.load(path)
     pixels = array.array("f", [0.0]) * (4 * image.size[0] * image.size[1])
     image.pixels.foreach_get(pixels)
-    size = tuple(image.size)
+    found = tuple(image.size)
     bpy.data.images.remove(image)
-    check(size == RENDER_SIZE, "the render is %dx%d" % size)
+    check(found == tuple(size), "the render is %dx%d" % found)
+    return pixels, seconds
+
+
+def render_alpha(scene, shown, name):
+    """Renders with only the objects in `shown` visible; returns (alpha values, seconds)."""
+    pixels, seconds = render_rgba(scene, shown, name)
     return pixels[3::4], seconds
 
 
@@ -1127,9 +1139,13 @@ def case_bake_volume():
     check(density.data_type == "FLOAT", "the density grid is a float grid (%s)" % density.data_type)
     material = volume.data.materials[0] if volume.data.materials else None
     node = material and next((n for n in material.node_tree.nodes if n.type == "PRINCIPLED_VOLUME"), None)
+    edge = material and next((n for n in material.node_tree.nodes if n.label == "Surface edge"), None)
     check(
-        node is not None and node.inputs["Density Attribute"].default_value == "density",
-        "a Principled Volume material reads the density grid",
+        node is not None
+        and node.inputs["Density"].is_linked
+        and edge is not None
+        and edge.inputs[0].links[0].from_node.attribute_name == "density",
+        "a Principled Volume material in the surface look: its density where the density grid passes the edge",
     )
     check(volume.matrix_world == obj.matrix_world, "the volume sits in the source's frame")
     check(not bakes.unrendered_sources(scene), "with its bake it renders")
@@ -1387,13 +1403,14 @@ def case_cancel():
     check(set(bpy.data.objects.keys()) == objects_before, "and adds no object")
 
 
-def render_scene_with_bakes(resolution, mesh=True):
-    """The default object, baked as a volume (and a mesh) at `resolution`."""
+def render_scene_with_bakes(resolution, mesh=True, look="SURFACE"):
+    """The default object, baked as a volume (in `look`) and a mesh at `resolution`."""
     clear_scene()
     scene = bpy.context.scene
     obj = new_dqjulia()
     make_active(obj)
     obj.dqjulia.bake_resolution = resolution
+    obj.dqjulia.volume_look = look
     check(bpy.ops.dqjulia.bake_volume(synchronous=True) == {"FINISHED"}, "Bake Volume at %d" % resolution)
     if mesh:
         check(bpy.ops.dqjulia.bake_mesh(synchronous=True) == {"FINISHED"}, "Bake Mesh at %d" % resolution)
@@ -1418,6 +1435,196 @@ def case_render():
         iou >= MESH_VOLUME_IOU,
         "the silhouettes of the baked volume and mesh agree: IoU %.4f >= %.2f" % (iou, MESH_VOLUME_IOU),
     )
+    check_first_render(scene, obj)
+
+
+# The first render (Frame Camera, Studio, the surface look) at FIRST_RENDER_SIZE: the share of the
+# frame the set covers (alpha > 0.5) and the mean luminance of its pixels (Rec. 709 of the PNG's
+# display values, 0..1), against Blender's default scene (its camera, point light and world).
+# Measured with the default object baked at 64^3, 8 samples: see README's Blender section.
+FIRST_RENDER_SIZE = (96, 72)
+FIRST_RENDER_COVER = 0.75  # after Frame Camera, at least this times the share `dqjulia render` covers
+FIRST_RENDER_LUMINANCE = 0.33  # the set's pixels at least this bright after Studio
+FIRST_RENDER_BRIGHTER = 1.15  # and this many times as bright as in the default scene
+
+
+def frame_figures(pixels):
+    """(share of the frame covered, mean luminance of the covered pixels)."""
+    covered = 0
+    luminance = 0.0
+    for index in range(0, len(pixels), 4):
+        if pixels[index + 3] > 0.5:
+            covered += 1
+            luminance += 0.2126 * pixels[index] + 0.7152 * pixels[index + 1] + 0.0722 * pixels[index + 2]
+    count = len(pixels) // 4
+    return covered / count, (luminance / covered if covered else 0.0)
+
+
+def default_scene_look(scene):
+    """Blender's factory scene around the object: its camera, its 1000 W point light, its grey
+    world (the startup file's values), as a new user's F12 sees it."""
+    camera = bpy.data.objects.new("Camera", bpy.data.cameras.new("Camera"))
+    camera.location = (7.3589, -6.9258, 4.9583)
+    camera.rotation_euler = (1.1093, 0.0, 0.8149)
+    scene.collection.objects.link(camera)
+    scene.camera = camera
+    light_data = bpy.data.lights.new("Light", "POINT")
+    light_data.energy = 1000.0
+    light = bpy.data.objects.new("Light", light_data)
+    light.location = (4.0762, 1.0055, 5.9039)
+    scene.collection.objects.link(light)
+    world = bpy.data.worlds.new("World")
+    world.color = (0.0509, 0.0509, 0.0509)
+    if bpy.app.version < (5, 0, 0):
+        world.use_nodes = True
+    background = next(node for node in world.node_tree.nodes if node.type == "BACKGROUND")
+    background.inputs["Color"].default_value = (0.0509, 0.0509, 0.0509, 1.0)
+    scene.world = world
+    return camera, light, world
+
+
+def check_first_render(scene, obj):
+    """Add, Bake Mesh and Bake Volume, then F12 in the default scene (today's figures), then
+    Frame Camera and Studio (the first render's), in the surface and the cloud look."""
+    from bpy_extras.object_utils import world_to_camera_view
+
+    studio = common.submodule(dqjulia, "studio")
+    report("== the first render: Frame Camera and Studio")
+    for old in [o for o in scene.objects if o.type in {"CAMERA", "LIGHT"}]:
+        bpy.data.objects.remove(old)
+    camera, light, world = default_scene_look(scene)
+    volume, mesh = baked_child(obj, "volume"), baked_child(obj, "mesh")
+    before = {
+        kind: frame_figures(render_rgba(scene, {o}, "default-" + kind, FIRST_RENDER_SIZE)[0])
+        for kind, o in (("mesh", mesh), ("volume", volume))
+    }
+
+    make_active(obj)
+    for operator in (studio.DQJULIA_OT_frame_camera, studio.DQJULIA_OT_studio):
+        check("UNDO" in operator.bl_options, "%s is undoable" % operator.bl_label)
+    with NoDeprecations("Frame Camera"):
+        result = bpy.ops.dqjulia.frame_camera()
+    check(result == {"FINISHED"} and scene.camera == camera, "Frame Camera aims the scene's camera")
+    center, radius = studio.world_bounds(obj)
+    projected = world_to_camera_view(scene, camera, center)
+    check(
+        abs(projected.x - 0.5) < 1e-4 and abs(projected.y - 0.5) < 1e-4,
+        "the bounds' centre is the frame's centre (%.5f, %.5f)" % (projected.x, projected.y),
+    )
+    aspect = FIRST_RENDER_SIZE[0] / FIRST_RENDER_SIZE[1]
+    tan_x, tan_y = studio.tan_half_fovs(camera.data, aspect)
+    distance = (camera.matrix_world.translation - center).length
+    fitted = radius / math.sin(math.atan(min(tan_x, tan_y))) * 1.08
+    check(
+        abs(distance - fitted) < 1e-4 * fitted, "as the core frames: the sphere fits with 8%% margin (%.4f)" % distance
+    )
+    light_before, world_before = (tuple(light.location), light.data.energy), tuple(world.color)
+    with NoDeprecations("Studio"):
+        check(bpy.ops.dqjulia.studio() == {"FINISHED"}, "Studio")
+    check(bpy.ops.dqjulia.studio() == {"FINISHED"}, "Studio again")
+    tagged = [o for o in bpy.data.objects if o.get(studio.STUDIO_KEY)]
+    check(
+        sorted(o.name for o in tagged) == ["DQ Julia Fill", "DQ Julia Key", "DQ Julia Rim"]
+        and all(o.users_collection[0].name == studio.COLLECTION_NAME for o in tagged)
+        and len([w for w in bpy.data.worlds if w.get(studio.STUDIO_KEY)]) == 1,
+        "Studio twice: three lights and one world, in their own collection (%s)" % sorted(o.name for o in tagged),
+    )
+    check(
+        (tuple(light.location), light.data.energy) == light_before
+        and tuple(world.color) == world_before
+        and world.name in bpy.data.worlds
+        and scene.world.get(studio.STUDIO_KEY),
+        "the user's light and world are untouched; the scene uses the studio's world",
+    )
+    after = {
+        kind: frame_figures(render_rgba(scene, {o}, "studio-" + kind, FIRST_RENDER_SIZE)[0])
+        for kind, o in (("mesh", mesh), ("volume", volume))
+    }
+    with native.Context() as context:  # `dqjulia render` of the same parameters: its alpha is coverage
+        context.set_params(object_document(obj))
+        core_pixels, _warning = context.render_rgba8(*FIRST_RENDER_SIZE)
+    core_cover = sum(1 for a in core_pixels[3::4] if a > 127) / (FIRST_RENDER_SIZE[0] * FIRST_RENDER_SIZE[1])
+    report("`dqjulia render` of the same parameters covers %.1f%% of its frame" % (100 * core_cover))
+    for kind in ("mesh", "volume"):
+        report(
+            "%s, Blender %s, %dx%d, %d samples: covers %.1f%% of the frame at mean luminance %.3f in the "
+            "default scene; %.1f%% at %.3f after Frame Camera and Studio"
+            % (
+                kind,
+                bpy.app.version_string,
+                FIRST_RENDER_SIZE[0],
+                FIRST_RENDER_SIZE[1],
+                RENDER_SAMPLES,
+                100 * before[kind][0],
+                before[kind][1],
+                100 * after[kind][0],
+                after[kind][1],
+            )
+        )
+        check(
+            after[kind][0] >= FIRST_RENDER_COVER * core_cover
+            and after[kind][1] >= max(FIRST_RENDER_LUMINANCE, FIRST_RENDER_BRIGHTER * before[kind][1]),
+            "the %s covers >= %.2f times what `dqjulia render` covers, lit >= %.2f and >= %.2f times the default "
+            "scene's" % (kind, FIRST_RENDER_COVER, FIRST_RENDER_LUMINANCE, FIRST_RENDER_BRIGHTER),
+        )
+
+    material = volume.data.materials[0]
+    check(
+        any(n.label == "Surface edge" for n in material.node_tree.nodes), "a baked volume reads as a surface by default"
+    )
+    obj.dqjulia.volume_look = "CLOUD"
+    material = volume.data.materials[0]
+    check(
+        not any(n.label == "Surface edge" for n in material.node_tree.nodes) and len(volume.data.materials) == 1,
+        "the cloud look gives the baked volume the fog's material",
+    )
+    cloud = frame_figures(render_rgba(scene, {volume}, "studio-cloud", FIRST_RENDER_SIZE)[0])
+    report("volume, cloud look: covers %.1f%% at mean luminance %.3f" % (100 * cloud[0], cloud[1]))
+    obj.dqjulia.volume_look = "SURFACE"
+
+    for old in [o for o in scene.objects if o.type == "CAMERA"]:
+        bpy.data.objects.remove(old)
+    check(bpy.ops.dqjulia.frame_camera() == {"FINISHED"}, "Frame Camera in a scene without a camera")
+    check(
+        scene.camera is not None
+        and scene.camera.get(studio.STUDIO_KEY) == "camera"
+        and scene.camera.users_collection[0].name == studio.COLLECTION_NAME,
+        "makes one, in the studio's collection",
+    )
+    fov = math.degrees(scene.camera.data.angle_y)
+    check(abs(fov - 40.0) < 1e-3, "with the document's field of view (%.3f degrees)" % fov)
+    placed = scene.camera.matrix_world.copy()
+    objects_before = set(bpy.data.objects.keys())
+    obj.dqjulia.bailout = 1.2  # invalid: nothing to frame or light
+    for operator in (bpy.ops.dqjulia.frame_camera, bpy.ops.dqjulia.studio):
+        result, error = common.call(operator)
+        check(
+            result == {"CANCELLED"} and "bailout" in error,
+            "invalid parameters: %s says why: %s" % (operator.idname_py(), error[:100]),
+        )
+    check(
+        scene.camera.matrix_world == placed and set(bpy.data.objects.keys()) == objects_before,
+        "and changes nothing",
+    )
+    obj.dqjulia.bailout = 4.0
+
+    # Undo: each is one step (True: as a click, undoable; background mode starts without a stack).
+    user_world = world.name
+    scene.world = world
+    for old in [o for o in scene.objects if o.type == "CAMERA"]:
+        bpy.data.objects.remove(old)
+    make_active(obj)
+    bpy.ops.ed.undo_push(message="before Frame Camera and Studio")
+    check(bpy.ops.dqjulia.frame_camera("EXEC_DEFAULT", True) == {"FINISHED"}, "Frame Camera (undoable)")
+    check(bpy.ops.dqjulia.studio("EXEC_DEFAULT", True) == {"FINISHED"}, "Studio (undoable)")
+    check(bpy.context.scene.world.name != user_world, "the scene uses the studio's world")
+    bpy.ops.ed.undo()
+    check(bpy.context.scene.world.name == user_world, "one undo gives the scene its own world again")
+    bpy.ops.ed.undo()
+    check(
+        bpy.context.scene.camera is None and not [o for o in bpy.data.objects if o.type == "CAMERA"],
+        "and another removes the camera Frame Camera made",
+    )
 
 
 def case_osl():
@@ -1439,7 +1646,7 @@ def case_osl():
             "Add OSL Volume says why it cannot run: %s" % error[:80],
         )
         return
-    scene, obj = render_scene_with_bakes(OSL_BAKE_RESOLUTION, mesh=False)
+    scene, obj = render_scene_with_bakes(OSL_BAKE_RESOLUTION, mesh=False, look="CLOUD")  # the OSL volume is fog
     engines = [item.identifier for item in bpy.types.RenderSettings.bl_rna.properties["engine"].enum_items]
     scene.render.engine = next(name for name in ("BLENDER_EEVEE_NEXT", "BLENDER_EEVEE") if name in engines)
     make_active(obj)
