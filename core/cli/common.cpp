@@ -187,8 +187,8 @@ void checkOutputPath(const std::string& path, bool force, const std::string& fla
         throw ParamError("output.path", flag + " '" + shown + "' exists; pass --force to overwrite it");
     const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
     if (!fs::is_directory(folder, error))
-        throw ParamError("output.path", flag + " '" + shown + "': the folder '" + inputExcerpt(platform::utf8FromPath(folder)) +
-                                            "' does not exist");
+        throw ParamError("output.path", flag + " '" + shown + "': the folder '" +
+                                            inputExcerpt(platform::utf8FromPath(folder)) + "' does not exist");
     if (!platform::folderWritable(platform::utf8FromPath(folder)))  // Windows cannot say (ACLs): the probe below tries
         throw ParamError("output.path", flag + " '" + shown + "': the folder '" +
                                             inputExcerpt(platform::utf8FromPath(folder)) + "' is not writable");
@@ -206,7 +206,8 @@ void checkDistinctOutputs(const std::vector<NamedPath>& outputs) {
         const std::string& path = outputs[index].path;
         std::error_code error;
         fs::path canonical = fs::weakly_canonical(fs::absolute(platform::pathFromUtf8(path), error), error);
-        const auto [at, added] = seen.emplace(error ? platform::pathFromUtf8(path).lexically_normal() : canonical, index);
+        const auto [at, added] =
+            seen.emplace(error ? platform::pathFromUtf8(path).lexically_normal() : canonical, index);
         if (!added)
             throw ParamError("output.path", outputs[at->second].flag + " and " + outputs[index].flag + " both name '" +
                                                 inputExcerpt(path) + "'; give them different files");

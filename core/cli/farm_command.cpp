@@ -85,8 +85,8 @@ std::string withoutExtension(const std::string& path) {
 
 /// `path` relative to the folder of `file`.
 std::string relativeTo(const std::string& path, const std::string& file) {
-    return platform::utf8FromPath(
-        platform::pathFromUtf8(path).lexically_relative(fs::absolute(platform::pathFromUtf8(file)).parent_path().lexically_normal()));
+    return platform::utf8FromPath(platform::pathFromUtf8(path).lexically_relative(
+        fs::absolute(platform::pathFromUtf8(file)).parent_path().lexically_normal()));
 }
 
 /// Plans the job and checks its files: the parameter file every task reads and `jobFiles`. Throws ParamError.
@@ -107,7 +107,8 @@ FarmPlan plan(const FarmFlags& flags, std::vector<NamedPath> jobFiles) {
     }
     const FrameRange range = plan.frames.value_or(FrameRange{});
     checkFrames(params, range.first, range.last);  // every frame valid before anything is submitted
-    plan.name = flags.name.empty() ? "dqjulia-" + platform::utf8FromPath(platform::pathFromUtf8(plan.output).stem()) : flags.name;
+    plan.name = flags.name.empty() ? "dqjulia-" + platform::utf8FromPath(platform::pathFromUtf8(plan.output).stem())
+                                   : flags.name;
     plan.nameFlag = flags.name.empty() ? "--output (its file name names the job: give --name)" : "--name";
     plan.dqjulia = platform::executablePath();
     plan.paramsPath = withoutExtension(plan.output) + ".params.json";
@@ -184,8 +185,10 @@ std::string runCapturing(const std::string& command) {
 
 int runSlurm(const FarmFlags& flags) {
     const std::string script =
-        flags.file.empty() ? withoutExtension(platform::utf8FromPath(fs::absolute(platform::pathFromUtf8(flags.bake.output)))) + ".slurm"
-                           : flags.file;
+        flags.file.empty()
+            ? withoutExtension(platform::utf8FromPath(fs::absolute(platform::pathFromUtf8(flags.bake.output)))) +
+                  ".slurm"
+            : flags.file;
     const std::string mergeScript =
         withoutExtension(script) + ".merge" + platform::utf8FromPath(platform::pathFromUtf8(script).extension());
     std::vector<NamedPath> jobFiles{{"--script", script}};
@@ -258,7 +261,8 @@ nlohmann::ordered_json openJdStep(const std::string& name, const FarmPlan& plan,
 int runOpenJd(const FarmFlags& flags) {
     const std::string file =
         flags.file.empty()
-            ? withoutExtension(platform::utf8FromPath(fs::absolute(platform::pathFromUtf8(flags.bake.output)))) + ".openjd.json"
+            ? withoutExtension(platform::utf8FromPath(fs::absolute(platform::pathFromUtf8(flags.bake.output)))) +
+                  ".openjd.json"
             : flags.file;
     FarmPlan job = plan(flags, {{"--template", file}});
     if (job.chunks() > kMaxOpenJdChunks)

@@ -40,7 +40,8 @@ std::optional<std::string> readSystemFile(const std::string& path) {
     try {
         text = readUpTo(path, kLimit + 1);
     } catch (const FileError& failure) {
-        if (failure.error()) throw std::system_error(failure.error(), std::generic_category(), "cannot read '" + path + "'");
+        if (failure.error())
+            throw std::system_error(failure.error(), std::generic_category(), "cannot read '" + path + "'");
         throw std::runtime_error("cannot read '" + path + "': " + failure.what());
     }
     if (text && text->size() > kLimit)
@@ -167,11 +168,11 @@ struct PendingFile::State {
     int fd = -1;
     std::string tempPath;  // "" with O_TMPFILE: the data has no name until publish()
     bool published = false;
-    int pathFd = -1;   // an O_PATH reference to the unnamed file between prepare() and publish()
-    int lockFd = -1;   // keeps a named temporary locked between prepare() and publish()
+    int pathFd = -1;        // an O_PATH reference to the unnamed file between prepare() and publish()
+    int lockFd = -1;        // keeps a named temporary locked between prepare() and publish()
     std::string asidePath;  // the hidden second name of the file this one replaces (setAside), or ""
-    int asideFd = -1;  // keeps the file set aside locked
-    dev_t device = 0;  // the written file's identity, so withdraw() removes only that file
+    int asideFd = -1;       // keeps the file set aside locked
+    dev_t device = 0;       // the written file's identity, so withdraw() removes only that file
     ino_t inode = 0;
 };
 

@@ -122,7 +122,8 @@ Found lookUp(const std::string& path) {
 }
 
 std::string nameLengthProblem(const std::string&, const std::string& name) {
-    if (pathFromUtf8(name).wstring().size() > 255) return "the file name is longer than Windows allows (255 characters)";
+    if (pathFromUtf8(name).wstring().size() > 255)
+        return "the file name is longer than Windows allows (255 characters)";
     return "";
 }
 
