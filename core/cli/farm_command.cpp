@@ -178,7 +178,7 @@ std::string slurmMergeScript(const FarmFlags& flags, const FarmPlan& plan) {
 /// Runs `command` through the shell; its standard output. Throws std::runtime_error when it fails.
 std::string runCapturing(const std::string& command) {
     const platform::CommandOutput result = platform::runCommand(command);
-    if (!result.succeeded)
+    if (result.exitCode != 0)
         throw std::runtime_error(command + " failed (exit " + std::to_string(result.exitCode) + "): " + result.output);
     return result.output;
 }

@@ -1,5 +1,5 @@
 // The parts of platform.hpp that are the same on every system, built on the system's steps of
-// platform_posix.cpp or platform_windows.cpp: hidden names, reading a small file.
+// platform_posix.cpp or platform_windows.cpp: hidden names, reading a small file, running a command.
 #include "platform/platform.hpp"
 
 #include <algorithm>
@@ -48,6 +48,16 @@ std::optional<std::string> readUpTo(const std::string& path, std::size_t limit) 
     closeFile(fd);
     if (failure) throw FileError(std::generic_category().message(failure), failure);
     return text;
+}
+
+CommandOutput runCommand(const std::string& command) {
+    std::FILE* pipe = openCommand(command);
+    if (!pipe) throw std::runtime_error("cannot run " + command);
+    CommandOutput result;
+    char buffer[512];
+    while (std::fgets(buffer, sizeof buffer, pipe)) result.output += buffer;
+    result.exitCode = closeCommand(pipe);
+    return result;
 }
 
 }  // namespace dqj::platform

@@ -214,14 +214,20 @@ std::vector<std::string> utf8Arguments(int argc, const wchar_t* const* wideArgv)
 /// The path of the running program, in UTF-8. Throws std::runtime_error when the system does not say.
 std::string executablePath();
 
-/// What runCommand saw: whether the command succeeded (its status 0), its exit code (-1 when it did
-/// not exit by itself, on POSIX), and what it wrote to standard output and standard error.
+/// popen(): `command` started by the system's shell, its standard output (with its standard
+/// error joined) to be read from the stream; nullptr when it cannot be started.
+std::FILE* openCommand(const std::string& command);
+/// pclose(): waits for the command; its exit code, or -1 when it did not exit by itself (a signal).
+int closeCommand(std::FILE* pipe);
+
+/// What runCommand saw: the command's exit code (0: it succeeded; -1: it did not exit by itself)
+/// and what it wrote to standard output and standard error.
 struct CommandOutput {
-    bool succeeded = false;
     int exitCode = -1;
     std::string output;
 };
-/// Runs `command` by the system's shell, its standard error joined to its standard output. Throws std::runtime_error when it cannot be started.
+/// Runs `command` by the system's shell (openCommand). Throws std::runtime_error when it cannot be
+/// started.
 CommandOutput runCommand(const std::string& command);
 
 }  // namespace dqj::platform

@@ -399,16 +399,11 @@ std::string executablePath() {
     return self.string();
 }
 
-CommandOutput runCommand(const std::string& command) {
-    FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-    if (!pipe) throw std::runtime_error("cannot run " + command);
-    CommandOutput result;
-    char buffer[512];
-    while (std::fgets(buffer, sizeof buffer, pipe)) result.output += buffer;
+std::FILE* openCommand(const std::string& command) { return ::popen((command + " 2>&1").c_str(), "r"); }
+
+int closeCommand(std::FILE* pipe) {
     const int status = ::pclose(pipe);
-    result.succeeded = status == 0;
-    result.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    return result;
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
 }  // namespace dqj::platform

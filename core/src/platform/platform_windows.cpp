@@ -318,16 +318,8 @@ std::string executablePath() {
     return utf8FromPath(std::filesystem::path(self));
 }
 
-CommandOutput runCommand(const std::string& command) {
-    FILE* pipe = ::_popen((command + " 2>&1").c_str(), "r");
-    if (!pipe) throw std::runtime_error("cannot run " + command);
-    CommandOutput result;
-    char buffer[512];
-    while (std::fgets(buffer, sizeof buffer, pipe)) result.output += buffer;
-    const int status = ::_pclose(pipe);
-    result.succeeded = status == 0;
-    result.exitCode = status;
-    return result;
-}
+std::FILE* openCommand(const std::string& command) { return ::_popen((command + " 2>&1").c_str(), "r"); }
+
+int closeCommand(std::FILE* pipe) { return ::_pclose(pipe); }
 
 }  // namespace dqj::platform
