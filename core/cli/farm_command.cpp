@@ -183,12 +183,14 @@ std::string runCapturing(const std::string& command) {
     return result.output;
 }
 
+/// --file, or the output's absolute path with `extension` for its own (out.vdb: out.slurm).
+std::string jobFile(const FarmFlags& flags, const std::string& extension) {
+    if (!flags.file.empty()) return flags.file;
+    return withoutExtension(platform::utf8FromPath(fs::absolute(platform::pathFromUtf8(flags.bake.output)))) + extension;
+}
+
 int runSlurm(const FarmFlags& flags) {
-    const std::string script =
-        flags.file.empty()
-            ? withoutExtension(platform::utf8FromPath(fs::absolute(platform::pathFromUtf8(flags.bake.output)))) +
-                  ".slurm"
-            : flags.file;
+    const std::string script = jobFile(flags, ".slurm");
     const std::string mergeScript =
         withoutExtension(script) + ".merge" + platform::utf8FromPath(platform::pathFromUtf8(script).extension());
     std::vector<NamedPath> jobFiles{{"--script", script}};
@@ -259,11 +261,7 @@ nlohmann::ordered_json openJdStep(const std::string& name, const FarmPlan& plan,
 }
 
 int runOpenJd(const FarmFlags& flags) {
-    const std::string file =
-        flags.file.empty()
-            ? withoutExtension(platform::utf8FromPath(fs::absolute(platform::pathFromUtf8(flags.bake.output)))) +
-                  ".openjd.json"
-            : flags.file;
+    const std::string file = jobFile(flags, ".openjd.json");
     FarmPlan job = plan(flags, {{"--template", file}});
     if (job.chunks() > kMaxOpenJdChunks)
         throw ParamError("frames", std::to_string(job.chunks()) +
