@@ -186,7 +186,8 @@ std::string runCapturing(const std::string& command) {
 /// --file, or the output's absolute path with `extension` for its own (out.vdb: out.slurm).
 std::string jobFile(const FarmFlags& flags, const std::string& extension) {
     if (!flags.file.empty()) return flags.file;
-    return withoutExtension(platform::utf8FromPath(fs::absolute(platform::pathFromUtf8(flags.bake.output)))) + extension;
+    return withoutExtension(platform::utf8FromPath(fs::absolute(platform::pathFromUtf8(flags.bake.output)))) +
+           extension;
 }
 
 int runSlurm(const FarmFlags& flags) {
