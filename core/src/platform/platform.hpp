@@ -3,7 +3,8 @@
 // process may use, console interrupts, the program's own path and running a command.
 //
 // Internal to libdqjulia and the command. Code: platform_posix.cpp (Linux and other POSIX systems)
-// or platform_windows.cpp (Windows, with MinGW-w64): core/CMakeLists.txt compiles one of them. Every
+// or platform_windows.cpp (Windows, with MinGW-w64): core/CMakeLists.txt compiles one of them; what
+// is the same on both, built on their steps, in platform.cpp (hidden names, readUpTo, runCommand). Every
 // `#ifdef _WIN32` of core/ lives under platform/, but where a comment (`// why:`) says why it cannot
 // (scripts/check-layout.py checks it). What the callers decide is the same on every system; how a
 // step is done is here. Costs nothing on Linux beyond the system calls; a UTF-16 conversion per
