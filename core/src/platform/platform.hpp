@@ -95,7 +95,12 @@ std::optional<std::string> readUpTo(const std::string& path, std::size_t limit);
 struct FileIdentity {
     std::uint64_t device = 0;
     std::uint64_t index = 0;
-    auto operator<=>(const FileIdentity&) const = default;
+    bool operator==(const FileIdentity&) const = default;
+    /// An order, so that a std::map can be keyed by identities (written out: clang-tidy 14 takes a
+    /// defaulted operator<=> for a literal 0 that wants nullptr).
+    bool operator<(const FileIdentity& other) const {
+        return device != other.device ? device < other.device : index < other.index;
+    }
 };
 /// The identity of the existing file at `path` (through symbolic links), or nullopt when
 /// nothing is there or it cannot be looked at.
