@@ -66,7 +66,8 @@ def system_tests(root: pathlib.Path) -> list[str]:
             if not any("why:" in text for text in comment):
                 findings.append(
                     f"{path.relative_to(root)}:{index + 1}: tests _WIN32 outside core/src/platform/: put the "
-                    'system\'s step behind platform/platform.hpp, or say in a comment above it ("why: ...") why it cannot'
+                    "system's step behind platform/platform.hpp, or say in a comment above it "
+                    '("why: ...") why it cannot'
                 )
     return findings
 
