@@ -1,7 +1,7 @@
 #include "bake_options.hpp"
 
 #include "dqjulia/threads.hpp"
-#include "files/file_names.hpp"
+#include "platform/platform.hpp"
 #include "files/message_text.hpp"
 #include "schema_options.hpp"
 
@@ -133,7 +133,7 @@ void BakeFlags::checkExistingFlags() const {
 }
 
 bool BakeFlags::skips(const std::string& path) const {
-    if (!skipExisting || !std::filesystem::is_regular_file(pathFromUtf8(path))) return false;
+    if (!skipExisting || !std::filesystem::is_regular_file(platform::pathFromUtf8(path))) return false;
     if (!quiet) std::cerr << "skipped " << path << ": it exists (--skip-existing)\n";
     return true;
 }
@@ -249,7 +249,7 @@ void printBakeStats(const BakeStats& stats) {
               << "pruned_leaves " << stats.prunedLeaves << "\n"
               << "active_voxels " << stats.activeVoxels << "\n"
               << "estimated_bytes " << stats.estimatedBytes << "\n"
-              << "peak_memory_bytes " << peakMemoryBytes() << "\n";
+              << "peak_memory_bytes " << platform::peakMemoryBytes() << "\n";
 }
 
 }  // namespace dqj::cli

@@ -14,7 +14,6 @@
 #include "dqjulia/params.hpp"
 #include "dqjulia/tiles.hpp"
 
-#include "bake/memory.hpp"  // peakMemoryBytes (internal)
 
 namespace dqj::cli {
 

@@ -1,14 +1,7 @@
 #include "common.hpp"
 
-#ifdef _WIN32
-#include <windows.h>
-#else
-#include <unistd.h>
-#endif
-
 #include <atomic>
 #include <chrono>
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -17,7 +10,7 @@
 
 #include "files/atomic_file.hpp"
 #include "dqjulia/estimate.hpp"
-#include "files/file_names.hpp"
+#include "platform/platform.hpp"
 #include "files/message_text.hpp"
 #include "schema_options.hpp"
 
@@ -25,26 +18,6 @@ namespace dqj::cli {
 namespace {
 
 std::atomic<bool> interruptRequested{false};
-
-#ifdef _WIN32
-/// Ctrl-C, Ctrl-Break and a closed console window (Windows stops the process shortly after that one).
-BOOL WINAPI onConsoleEvent(DWORD event) {
-    if (event != CTRL_C_EVENT && event != CTRL_BREAK_EVENT && event != CTRL_CLOSE_EVENT) return FALSE;
-    interruptRequested.store(true);
-    return TRUE;
-}
-
-/// Whether stderr is a console that draws the bar's escape codes (Windows 10 and later, once asked).
-bool stderrIsTerminal() {
-    const HANDLE console = ::GetStdHandle(STD_ERROR_HANDLE);
-    DWORD mode = 0;
-    return ::GetConsoleMode(console, &mode) && ::SetConsoleMode(console, mode | ENABLE_VIRTUAL_TERMINAL_PROCESSING);
-}
-#else
-extern "C" void onInterrupt(int) { interruptRequested.store(true); }
-
-bool stderrIsTerminal() { return isatty(STDERR_FILENO); }
-#endif
 
 double nowSeconds() {
     using namespace std::chrono;
@@ -104,16 +77,7 @@ std::string formatDuration(double seconds) {
 }  // namespace
 
 void installInterruptHandlers() {
-#ifdef _WIN32
-    ::SetConsoleCtrlHandler(onConsoleEvent, TRUE);
-#else
-    struct sigaction action {};
-    action.sa_handler = onInterrupt;
-    sigemptyset(&action.sa_mask);
-    sigaction(SIGINT, &action, nullptr);
-    sigaction(SIGTERM, &action, nullptr);
-    sigaction(SIGHUP, &action, nullptr);  // a closed terminal or a dropped SSH session: stop cleanly as for SIGTERM
-#endif
+    platform::onInterrupt([] { interruptRequested.store(true); });
 }
 
 bool interrupted() { return interruptRequested.load(); }
@@ -124,7 +88,7 @@ CLI::Validator existingFile() {
             std::error_code error;
             std::filesystem::file_status status;
             try {
-                status = std::filesystem::status(pathFromUtf8(name), error);
+                status = std::filesystem::status(platform::pathFromUtf8(name), error);
             } catch (const std::filesystem::filesystem_error&) {
                 return "File name is not valid UTF-8: " + inputExcerpt(name);
             }
@@ -209,11 +173,9 @@ void checkOutputPath(const std::string& path, bool force, const std::string& fla
     namespace fs = std::filesystem;
     std::error_code error;
     if (path.empty()) throw ParamError("output.path", flag + " is empty; give a file name");
-#ifdef _WIN32
-    if (const std::string problem = windowsNameProblem(path); !problem.empty())
+    if (const std::string problem = systemNameProblem(path); !problem.empty())
         throw ParamError("output.path", flag + " '" + inputExcerpt(path) + "': " + problem);
-#endif
-    const fs::path target = pathFromUtf8(path);
+    const fs::path target = platform::pathFromUtf8(path);
     const std::string shown = inputExcerpt(path);
     if (fs::is_directory(target, error))
         throw ParamError("output.path", flag + " '" + shown + "' is a folder; give a file name");
@@ -225,13 +187,11 @@ void checkOutputPath(const std::string& path, bool force, const std::string& fla
         throw ParamError("output.path", flag + " '" + shown + "' exists; pass --force to overwrite it");
     const fs::path folder = target.has_parent_path() ? target.parent_path() : fs::path(".");
     if (!fs::is_directory(folder, error))
-        throw ParamError("output.path", flag + " '" + shown + "': the folder '" + inputExcerpt(utf8FromPath(folder)) +
-                                            "' does not exist");
-#ifndef _WIN32  // Windows: access() does not read a folder's permissions (ACLs); the probe below tries
-    if (::access(folder.c_str(), W_OK) != 0)
-        throw ParamError("output.path",
-                         flag + " '" + shown + "': the folder '" + inputExcerpt(folder.string()) + "' is not writable");
-#endif
+        throw ParamError("output.path", flag + " '" + shown + "': the folder '" +
+                                            inputExcerpt(platform::utf8FromPath(folder)) + "' does not exist");
+    if (!platform::folderWritable(platform::utf8FromPath(folder)))  // Windows cannot say (ACLs): the probe below tries
+        throw ParamError("output.path", flag + " '" + shown + "': the folder '" +
+                                            inputExcerpt(platform::utf8FromPath(folder)) + "' is not writable");
     try {
         checkWritable(path);  // not a device or FIFO, and a file can really be created there
     } catch (const std::runtime_error& failure) {
@@ -245,8 +205,9 @@ void checkDistinctOutputs(const std::vector<NamedPath>& outputs) {
     for (std::size_t index = 0; index < outputs.size(); ++index) {
         const std::string& path = outputs[index].path;
         std::error_code error;
-        fs::path canonical = fs::weakly_canonical(fs::absolute(pathFromUtf8(path), error), error);
-        const auto [at, added] = seen.emplace(error ? pathFromUtf8(path).lexically_normal() : canonical, index);
+        fs::path canonical = fs::weakly_canonical(fs::absolute(platform::pathFromUtf8(path), error), error);
+        const auto [at, added] =
+            seen.emplace(error ? platform::pathFromUtf8(path).lexically_normal() : canonical, index);
         if (!added)
             throw ParamError("output.path", outputs[at->second].flag + " and " + outputs[index].flag + " both name '" +
                                                 inputExcerpt(path) + "'; give them different files");
@@ -254,12 +215,12 @@ void checkDistinctOutputs(const std::vector<NamedPath>& outputs) {
 }
 
 void checkInputsKept(const std::vector<NamedPath>& outputs, const std::vector<NamedPath>& inputs) {
-    std::map<FileIdentity, const NamedPath*> read;
+    std::map<platform::FileIdentity, const NamedPath*> read;
     for (const NamedPath& input : inputs)
-        if (const auto identity = fileIdentity(input.path)) read.emplace(*identity, &input);
+        if (const auto identity = platform::fileIdentity(input.path)) read.emplace(*identity, &input);
     if (read.empty()) return;
     for (const NamedPath& output : outputs) {
-        const auto identity = fileIdentity(output.path);
+        const auto identity = platform::fileIdentity(output.path);
         const auto found = identity ? read.find(*identity) : read.end();
         if (found == read.end()) continue;
         const NamedPath& input = *found->second;
@@ -334,7 +295,7 @@ int reportErrors(const std::string& command, const std::function<int()>& body) {
 }
 
 ProgressBar::ProgressBar(std::string label, bool quiet)
-    : label_(std::move(label)), enabled_(!quiet && stderrIsTerminal()), startSeconds_(nowSeconds()) {}
+    : label_(std::move(label)), enabled_(!quiet && platform::stderrIsTerminal()), startSeconds_(nowSeconds()) {}
 
 ProgressBar::~ProgressBar() {
     if (drawn_) std::cerr << "\n";

@@ -10,6 +10,8 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "platform/platform.hpp"
+
 namespace dqj {
 namespace {
 
@@ -104,12 +106,12 @@ std::vector<std::string> wrap(Font& font, const std::string& label, int maxWidth
 
 std::string labelFontPath() {
     if (const char* chosen = std::getenv("DQJ_FONT"); chosen && std::filesystem::exists(chosen)) return chosen;
-#ifdef _WIN32
-    const char* windows = std::getenv("WINDIR");
-    const std::string fonts = std::string(windows ? windows : "C:\\Windows") + "\\Fonts\\";
-    for (const std::string& candidate : {fonts + "segoeui.ttf", fonts + "arial.ttf", fonts + "tahoma.ttf"})
-        if (std::filesystem::exists(candidate)) return candidate;
-#endif
+    if (platform::kWindows) {
+        const char* windows = std::getenv("WINDIR");
+        const std::string fonts = std::string(windows ? windows : "C:\\Windows") + "\\Fonts\\";
+        for (const std::string& candidate : {fonts + "segoeui.ttf", fonts + "arial.ttf", fonts + "tahoma.ttf"})
+            if (std::filesystem::exists(candidate)) return candidate;
+    }
     for (const char* candidate :
          {"/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf", "/usr/share/fonts/TTF/DejaVuSans.ttf",
           "/usr/share/fonts/dejavu/DejaVuSans.ttf", "/usr/share/fonts/truetype/liberation/LiberationSans-Regular.ttf"})

@@ -12,7 +12,7 @@
 #include "files/atomic_file.hpp"
 #include "dqjulia/render.hpp"
 #include "dqjulia/variations.hpp"
-#include "files/file_names.hpp"
+#include "platform/platform.hpp"
 #include "render/image_writer.hpp"
 #include "files/message_text.hpp"
 
@@ -131,18 +131,16 @@ int runExplore(ExploreCommandOptions options) {
     start.load();
 
     namespace fs = std::filesystem;
-    const fs::path folder = pathFromUtf8(options.folder);
+    const fs::path folder = platform::pathFromUtf8(options.folder);
     const fs::path sheetPath = folder / "sheet.png";
     // The folder is checked before it is made (a name Windows cannot hold, a file or a dangling
     // link in its place); the folders made here are removed again unless the run publishes its files.
-#ifdef _WIN32
-    if (const std::string problem = windowsNameProblem(options.folder); !problem.empty())
+    if (const std::string problem = systemNameProblem(options.folder); !problem.empty())
         throw ParamError("output.path", "--output '" + inputExcerpt(options.folder) + "': " + problem);
-#endif
     std::error_code error;
     if (fs::is_symlink(folder, error) && !fs::exists(folder, error))
         throw ParamError("output.path", "--output '" + inputExcerpt(options.folder) + "' is a symbolic link to '" +
-                                            utf8FromPath(fs::read_symlink(folder, error)) +
+                                            platform::utf8FromPath(fs::read_symlink(folder, error)) +
                                             "', which does not exist; give a folder");
     if (fs::exists(folder, error) && !fs::is_directory(folder, error))
         throw ParamError("output.path",
@@ -159,10 +157,10 @@ int runExplore(ExploreCommandOptions options) {
         std::snprintf(name, sizeof name, "tile_%02zu", index + 1);
         return std::string(name);
     };
-    std::vector<NamedPath> outputs{{"--output", utf8FromPath(sheetPath)}};
+    std::vector<NamedPath> outputs{{"--output", platform::utf8FromPath(sheetPath)}};
     for (std::size_t index = 0; index < std::size_t(options.count); ++index)
         for (const char* extension : {".png", ".json"})
-            outputs.push_back({"--output", utf8FromPath(folder / (tileName(index) + extension))});
+            outputs.push_back({"--output", platform::utf8FromPath(folder / (tileName(index) + extension))});
     std::vector<NamedPath> inputs = options.fractal.inputs();
     if (around) inputs.push_back({"--around", options.around});
     checkOutputs(outputs, inputs, options.force);
@@ -178,10 +176,10 @@ int runExplore(ExploreCommandOptions options) {
     for (std::size_t index = 0; index < count; ++index) {
         Params tile = documents.documents[index];
         const std::string name = tileName(index);
-        const std::string picture = utf8FromPath(folder / (name + ".png"));
+        const std::string picture = platform::utf8FromPath(folder / (name + ".png"));
         // A variation keeps its document's size and names its own full-size picture; a random
         // constant's document is the tile's.
-        tile.output.path = around ? utf8FromPath(folder / (name + "_render.png")) : picture;
+        tile.output.path = around ? platform::utf8FromPath(folder / (name + "_render.png")) : picture;
         Params thumbnail = tile;
         thumbnail.render.width = options.width;
         thumbnail.render.height = options.height;
@@ -191,18 +189,18 @@ int runExplore(ExploreCommandOptions options) {
         const RenderResult result =
             render(thumbnail, [&](double fraction) { return callback(start + share * fraction); });
         writeImage(result.image, files.add(picture), ImageFormat::Png8);
-        files.add(utf8FromPath(folder / (name + ".json"))).stream() << toJson(tile);
+        files.add(platform::utf8FromPath(folder / (name + ".json"))).stream() << toJson(tile);
         tiles.push_back({result.image, name + "  " + constantText(tile.fractal.c, 3)});
     }
     progress.finish();
     SheetLayout layout;
     layout.columns = options.columns;
-    writeImage(composeSheet(tiles, layout), files.add(utf8FromPath(sheetPath)), ImageFormat::Png8);
+    writeImage(composeSheet(tiles, layout), files.add(platform::utf8FromPath(sheetPath)), ImageFormat::Png8);
     if (interrupted()) throw Cancelled();  // a signal in the last moments of the work: write nothing
     files.commit();
     made.keep = true;
     if (!options.quiet)
-        std::cerr << "wrote " << utf8FromPath(sheetPath) << " and " << tiles.size()
+        std::cerr << "wrote " << platform::utf8FromPath(sheetPath) << " and " << tiles.size()
                   << " tiles (tile_NN.png, tile_NN.json) to " << options.folder << "; " << documents.summary << "\n";
     return kSuccess;
 }

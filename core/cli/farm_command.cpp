@@ -15,12 +15,6 @@
 // Every name and path goes into the files through job_files.hpp's writers, quoted for the
 // format's own parser or refused (exit 2) before anything is written.
 // Cost: writing two or three small files; checking the frames (keyframes.hpp's checkFrames).
-#ifdef _WIN32
-#include <windows.h>
-#else
-#include <sys/wait.h>
-#endif
-
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -35,7 +29,7 @@
 #include "dqjulia/dqjulia.h"
 #include "dqjulia/threads.hpp"
 #include "dqjulia/tiles.hpp"
-#include "files/file_names.hpp"
+#include "platform/platform.hpp"
 #include "job_files.hpp"
 
 namespace dqj::cli {
@@ -86,28 +80,13 @@ struct FarmPlan {
 };
 
 std::string withoutExtension(const std::string& path) {
-    return utf8FromPath(pathFromUtf8(path).parent_path() / pathFromUtf8(path).stem());
+    return platform::utf8FromPath(platform::pathFromUtf8(path).parent_path() / platform::pathFromUtf8(path).stem());
 }
 
 /// `path` relative to the folder of `file`.
 std::string relativeTo(const std::string& path, const std::string& file) {
-    return utf8FromPath(
-        pathFromUtf8(path).lexically_relative(fs::absolute(pathFromUtf8(file)).parent_path().lexically_normal()));
-}
-
-std::string thisExecutable() {
-#ifdef _WIN32
-    std::wstring self(32768, L'\0');
-    const DWORD length = ::GetModuleFileNameW(nullptr, self.data(), DWORD(self.size()));
-    if (length == 0 || length >= self.size()) throw std::runtime_error("cannot find this dqjulia's path");
-    self.resize(length);
-    return utf8FromPath(fs::path(self));
-#else
-    std::error_code error;
-    const fs::path self = fs::read_symlink("/proc/self/exe", error);
-    if (error) throw std::runtime_error("cannot find this dqjulia's path (/proc/self/exe): " + error.message());
-    return self.string();
-#endif
+    return platform::utf8FromPath(platform::pathFromUtf8(path).lexically_relative(
+        fs::absolute(platform::pathFromUtf8(file)).parent_path().lexically_normal()));
 }
 
 /// Plans the job and checks its files: the parameter file every task reads and `jobFiles`. Throws ParamError.
@@ -116,7 +95,7 @@ FarmPlan plan(const FarmFlags& flags, std::vector<NamedPath> jobFiles) {
     FarmPlan plan;
     plan.params = bake.load();
     const Params& params = plan.params;
-    plan.output = utf8FromPath(fs::absolute(pathFromUtf8(bake.output)).lexically_normal());
+    plan.output = platform::utf8FromPath(fs::absolute(platform::pathFromUtf8(bake.output)).lexically_normal());
     if (AtomicFile::lowercaseExtension(plan.output) != ".vdb")
         throw ParamError("output.path", "--output '" + inputExcerpt(bake.output) + "' must end in .vdb");
     plan.frames = bake.frameRange();
@@ -128,9 +107,10 @@ FarmPlan plan(const FarmFlags& flags, std::vector<NamedPath> jobFiles) {
     }
     const FrameRange range = plan.frames.value_or(FrameRange{});
     checkFrames(params, range.first, range.last);  // every frame valid before anything is submitted
-    plan.name = flags.name.empty() ? "dqjulia-" + utf8FromPath(pathFromUtf8(plan.output).stem()) : flags.name;
+    plan.name = flags.name.empty() ? "dqjulia-" + platform::utf8FromPath(platform::pathFromUtf8(plan.output).stem())
+                                   : flags.name;
     plan.nameFlag = flags.name.empty() ? "--output (its file name names the job: give --name)" : "--name";
-    plan.dqjulia = thisExecutable();
+    plan.dqjulia = platform::executablePath();
     plan.paramsPath = withoutExtension(plan.output) + ".params.json";
     jobFiles.insert(jobFiles.begin(), {"the parameter file", plan.paramsPath});
     checkOutputs(jobFiles, bake.fractal.inputs(), bake.force);
@@ -195,34 +175,25 @@ std::string slurmMergeScript(const FarmFlags& flags, const FarmPlan& plan) {
     return script.text();
 }
 
-/// Runs `command` through sh; its standard output. Throws std::runtime_error when it fails.
+/// Runs `command` through the shell; its standard output. Throws std::runtime_error when it fails.
 std::string runCapturing(const std::string& command) {
-#ifdef _WIN32
-    FILE* pipe = ::_popen((command + " 2>&1").c_str(), "r");
-#else
-    FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
-#endif
-    if (!pipe) throw std::runtime_error("cannot run " + command);
-    std::string output;
-    char buffer[512];
-    while (std::fgets(buffer, sizeof buffer, pipe)) output += buffer;
-#ifdef _WIN32
-    const int status = ::_pclose(pipe);
-    const int code = status;
-#else
-    const int status = ::pclose(pipe);
-    const int code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-#endif
-    if (status != 0) throw std::runtime_error(command + " failed (exit " + std::to_string(code) + "): " + output);
-    return output;
+    const platform::CommandOutput result = platform::runCommand(command);
+    if (result.exitCode != 0)
+        throw std::runtime_error(command + " failed (exit " + std::to_string(result.exitCode) + "): " + result.output);
+    return result.output;
+}
+
+/// --file, or the output's absolute path with `extension` for its own (out.vdb: out.slurm).
+std::string jobFile(const FarmFlags& flags, const std::string& extension) {
+    if (!flags.file.empty()) return flags.file;
+    return withoutExtension(platform::utf8FromPath(fs::absolute(platform::pathFromUtf8(flags.bake.output)))) +
+           extension;
 }
 
 int runSlurm(const FarmFlags& flags) {
-    const std::string script =
-        flags.file.empty() ? withoutExtension(utf8FromPath(fs::absolute(pathFromUtf8(flags.bake.output)))) + ".slurm"
-                           : flags.file;
+    const std::string script = jobFile(flags, ".slurm");
     const std::string mergeScript =
-        withoutExtension(script) + ".merge" + utf8FromPath(pathFromUtf8(script).extension());
+        withoutExtension(script) + ".merge" + platform::utf8FromPath(platform::pathFromUtf8(script).extension());
     std::vector<NamedPath> jobFiles{{"--script", script}};
     if (!flags.bake.tiles.empty()) jobFiles.push_back({"the merge script", mergeScript});
     FarmPlan job = plan(flags, jobFiles);
@@ -291,10 +262,7 @@ nlohmann::ordered_json openJdStep(const std::string& name, const FarmPlan& plan,
 }
 
 int runOpenJd(const FarmFlags& flags) {
-    const std::string file =
-        flags.file.empty()
-            ? withoutExtension(utf8FromPath(fs::absolute(pathFromUtf8(flags.bake.output)))) + ".openjd.json"
-            : flags.file;
+    const std::string file = jobFile(flags, ".openjd.json");
     FarmPlan job = plan(flags, {{"--template", file}});
     if (job.chunks() > kMaxOpenJdChunks)
         throw ParamError("frames", std::to_string(job.chunks()) +

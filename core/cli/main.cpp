@@ -5,14 +5,11 @@
 #include <string>
 #include <vector>
 
-#ifdef _WIN32
-#include <windows.h>
-#endif
-
 #include "commands.hpp"
 #include "common.hpp"
 #include "dqjulia/dqjulia.h"
 #include "files/message_text.hpp"
+#include "platform/platform.hpp"
 
 namespace {
 
@@ -106,23 +103,16 @@ int runReported(int argc, char** argv) {
 
 }  // namespace
 
+// why: the program's entry point is the system's choice. Windows hands narrow arguments in the ANSI
+// code page, which cannot hold every file name, so there the command starts at wmain (linked with
+// -municode) and takes its UTF-16 arguments as UTF-8, the toolkit's file names
+// (platform::utf8Arguments, which also has the console show UTF-8).
 #ifdef _WIN32
-// Windows hands narrow arguments in the ANSI code page, which cannot hold every file name: the
-// command takes its UTF-16 arguments (wmain, linked with -municode) as UTF-8, the toolkit's file
-// names, and writes UTF-8 to the console.
 int wmain(int argc, wchar_t** wideArgv) {
-    std::vector<std::string> arguments;
-    for (int index = 0; index < argc; ++index) {
-        const int bytes = ::WideCharToMultiByte(CP_UTF8, 0, wideArgv[index], -1, nullptr, 0, nullptr, nullptr);
-        std::string argument(bytes > 0 ? std::size_t(bytes) : 1, '\0');
-        ::WideCharToMultiByte(CP_UTF8, 0, wideArgv[index], -1, argument.data(), bytes, nullptr, nullptr);
-        argument.resize(argument.size() - 1);  // the terminating NUL
-        arguments.push_back(std::move(argument));
-    }
+    std::vector<std::string> arguments = dqj::platform::utf8Arguments(argc, wideArgv);
     std::vector<char*> argv;
     for (std::string& argument : arguments) argv.push_back(argument.data());
     argv.push_back(nullptr);
-    ::SetConsoleOutputCP(CP_UTF8);
     return runReported(argc, argv.data());
 }
 #else

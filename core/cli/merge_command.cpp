@@ -9,7 +9,7 @@
 #include "common.hpp"
 #include "dqjulia/threads.hpp"
 #include "dqjulia/tiles.hpp"
-#include "files/file_names.hpp"
+#include "platform/platform.hpp"
 #include "files/message_text.hpp"
 
 namespace dqj::cli {
@@ -41,7 +41,7 @@ int runMerge(const MergeFlags& flags) {
         if (bake.skips(path)) continue;
         std::string missing;
         for (const std::string& input : inputs)
-            if (std::error_code error; !std::filesystem::is_regular_file(pathFromUtf8(input), error))
+            if (std::error_code error; !std::filesystem::is_regular_file(platform::pathFromUtf8(input), error))
                 missing += (missing.empty() ? "'" : ", '") + inputExcerpt(input) + "'";
         if (!missing.empty())
             throw ParamError("tiles", "no tile " + missing + ": bake it first (dqjulia bake --tiles)");
@@ -66,7 +66,7 @@ int runMerge(const MergeFlags& flags) {
         if (bake.stats) {
             std::cout << "output " << path << "\ntiles " << stats.tiles << "\nactive_voxels " << stats.activeVoxels
                       << "\ntile_bytes " << stats.tileBytes << "\nseconds " << stats.seconds << "\npeak_memory_bytes "
-                      << peakMemoryBytes() << "\n";
+                      << platform::peakMemoryBytes() << "\n";
         }
     }
     return kSuccess;

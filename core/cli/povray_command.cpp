@@ -9,7 +9,7 @@
 #include "dqjulia/empty_result.hpp"
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/povray.hpp"
-#include "files/file_names.hpp"
+#include "platform/platform.hpp"
 #include "files/message_text.hpp"
 #include "files/text_input.hpp"
 #include "schema_options.hpp"
@@ -69,7 +69,7 @@ int runPovray(const PovrayOptions& options) {
     for (const NamedPath& output : outputs) checkOutputPath(output.path, options.force, output.flag);
     if (!files.include.empty()) {
         std::error_code error;
-        const bool regular = std::filesystem::is_regular_file(pathFromUtf8(files.include), error);
+        const bool regular = std::filesystem::is_regular_file(platform::pathFromUtf8(files.include), error);
         const bool same = regular && fileHolds(files.include, povrayInclude()) == true;
         if (regular && !same && !options.force)
             throw ParamError("output.path", "'" + inputExcerpt(files.include) +
@@ -88,10 +88,10 @@ int runPovray(const PovrayOptions& options) {
         for (const std::string& path : written) std::cerr << "wrote " << path << "\n";
         // POV-Ray looks for the include and the DF3 file in the folder it runs in and on its
         // library path, not beside the scene: run it in the scene's folder.
-        const std::filesystem::path scene = pathFromUtf8(files.scene.empty() ? files.df3Scene : files.scene);
+        const std::filesystem::path scene = platform::pathFromUtf8(files.scene.empty() ? files.df3Scene : files.scene);
         std::cerr << "render with: "
-                  << (scene.has_parent_path() ? "cd '" + utf8FromPath(scene.parent_path()) + "' && " : "")
-                  << povrayCommand(params, utf8FromPath(scene.filename()))
+                  << (scene.has_parent_path() ? "cd '" + platform::utf8FromPath(scene.parent_path()) + "' && " : "")
+                  << povrayCommand(params, platform::utf8FromPath(scene.filename()))
                   << (write.copyInclude ? "" : " +L<dqjulia>/povray") << "\n";
     }
     return kSuccess;

@@ -26,20 +26,9 @@ namespace {
 
 using Outcome = dqj::test::CommandResult;
 
-class BakeCli : public ::testing::Test {
+class BakeCli : public dqj::test::ScratchFolder {
 protected:
-    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_bake_cli"); }
-    void TearDown() override { fs::remove_all(dir_); }
-
     Outcome run(const std::string& arguments) { return dqj::test::runCommand(DQJ_CLI, arguments, dir_); }
-    std::string path(const std::string& name) const { return (dir_ / name).string(); }
-    std::string write(const std::string& name, const std::string& text) {
-        std::ofstream(dir_ / name) << text;
-        return path(name);
-    }
-    std::vector<std::string> files() const { return dqj::test::fileNames(dir_); }
-
-    fs::path dir_;
 };
 
 /// The value of "key N" in --stats output.

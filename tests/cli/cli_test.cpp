@@ -25,22 +25,12 @@ namespace {
 
 using Outcome = dqj::test::CommandResult;
 
-class Cli : public ::testing::Test {
+class Cli : public dqj::test::ScratchFolder {
 protected:
-    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_cli"); }
-    void TearDown() override { fs::remove_all(dir_); }
-
     /// Runs `dqjulia <arguments>` with `input` on stdin.
     Outcome run(const std::string& arguments, const std::string& input = "") {
         return dqj::test::runCommand(DQJ_CLI, arguments, dir_, input);
     }
-    std::string path(const std::string& name) const { return (dir_ / name).string(); }
-    std::string write(const std::string& name, const std::string& text) {
-        std::ofstream(dir_ / name) << text;
-        return path(name);
-    }
-
-    fs::path dir_;
 };
 
 std::vector<std::vector<std::string>> csvRows(const std::string& text) {

@@ -20,20 +20,12 @@ using dqj::test::readFile;
 
 namespace {
 
-class FarmCli : public ::testing::Test {
+class FarmCli : public dqj::test::ScratchFolder {
 protected:
-    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_farm_cli"); }
-    void TearDown() override { fs::remove_all(dir_); }
     dqj::test::CommandResult run(const std::string& arguments) {
         return dqj::test::runCommand(DQJ_CLI, arguments, dir_);
     }
-    std::string path(const std::string& name) const { return (dir_ / name).string(); }
     std::string quoted(const std::string& name) const { return "'" + path(name) + "'"; }
-    std::string write(const std::string& name, const std::string& text) {
-        std::ofstream(dir_ / name) << text;
-        return path(name);
-    }
-    fs::path dir_;
 };
 
 /// A VDB file without the 36-byte random id OpenVDB writes into every file's header (from

@@ -33,10 +33,8 @@ struct HelpOption {
     std::string longName() const { return names.substr(names.rfind(',') + 1); }
 };
 
-class SchemaFlags : public ::testing::Test {
+class SchemaFlags : public dqj::test::ScratchFolder {
 protected:
-    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_schema_flags"); }
-    void TearDown() override { fs::remove_all(dir_); }
     dqj::test::CommandResult run(const std::string& arguments) {
         return dqj::test::runCommand(DQJ_CLI, arguments, dir_);
     }
@@ -86,8 +84,6 @@ protected:
         }
         return result;
     }
-
-    fs::path dir_;
 };
 
 /// "above 0, at most 1" or "1 to 100000" against the field's min, max and exclusivity.

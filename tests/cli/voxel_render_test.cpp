@@ -85,24 +85,18 @@ std::pair<double, double> centroid(const std::vector<bool>& mask) {
     return {x / count, y / count};
 }
 
-class VoxelRender : public ::testing::Test {
+class VoxelRender : public dqj::test::ScratchFolder {
 protected:
-    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_voxel_render"); }
-    void TearDown() override { fs::remove_all(dir_); }
-
     /// Runs `dqjulia <arguments>`; fails the test if it does not exit 0.
     void run(const std::string& arguments) {
         const dqj::test::CommandResult result = dqj::test::runCommand(DQJ_CLI, arguments, dir_, "");
         ASSERT_EQ(result.exitCode, 0) << arguments << "\n" << result.err;
     }
-    std::string path(const std::string& name) const { return (dir_ / name).string(); }
     /// `render` of the same view: traced, or the voxels of `vdb` when it is given.
     void render(const std::string& fractal, const std::string& output, const std::string& vdb = "") {
         run("render -q -s 1 -W " + std::to_string(kWidth) + " -H " + std::to_string(kHeight) + " " + fractal +
             (vdb.empty() ? "" : " --voxels " + path(vdb)) + " -o " + path(output));
     }
-
-    fs::path dir_;
 };
 
 TEST_F(VoxelRender, TheUnitBallAsCubesLinesUpWithTheTracedBall) {

@@ -138,8 +138,10 @@ inline std::vector<std::string> fileNames(const std::filesystem::path& folder) {
 }
 
 /// The fixture of a test that works in a folder of its own: "<temp>/dqjulia_<suite>_<pid>_<test>"
-/// (freshTestFolder), made before the test and removed after it. Suites use it by name
-/// (`using Scratch = ScratchFolder;`) or derive from it (bake_fixture.hpp's BakeFolder).
+/// (freshTestFolder), made before the test and removed after it (kept after a failed test when
+/// keepWhenFailed_ is set, to look at what it made). Suites use it by name
+/// (`using Scratch = ScratchFolder;`) or derive from it (bake_fixture.hpp's BakeFolder, the
+/// command's tests' fixtures); a suite's own SetUp and TearDown call these first and last.
 class ScratchFolder : public ::testing::Test {
 public:
     void SetUp() override {
@@ -148,10 +150,20 @@ public:
             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
         dir_ = freshTestFolder("dqjulia_" + suite);
     }
-    void TearDown() override { std::filesystem::remove_all(dir_); }
+    void TearDown() override {
+        if (!(keepWhenFailed_ && HasFailure())) std::filesystem::remove_all(dir_);
+    }
     std::string path(const std::string& name) const { return (dir_ / name).string(); }
     std::vector<std::string> files() const { return fileNames(dir_); }
+    /// Writes `text` (bytes as given) to the file `name` in the folder; its path.
+    std::string write(const std::string& name, const std::string& text) const {
+        std::ofstream(dir_ / name, std::ios::binary) << text;
+        return path(name);
+    }
     std::filesystem::path dir_;
+
+protected:
+    bool keepWhenFailed_ = false;
 };
 
 /// mt19937_64 is specified exactly by the standard, its distributions are not: the bits are

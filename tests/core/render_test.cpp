@@ -65,17 +65,8 @@ double encodeSrgb(double linear) {
     return linear <= 0.0031308 ? 12.92 * linear : 1.055 * std::pow(linear, 1.0 / 2.4) - 0.055;
 }
 
-/// A fresh folder per test, removed afterwards.
-class TempFolder {
-public:
-    TempFolder() { path_ = dqj::test::freshTestFolder("dqjulia_render_test"); }
-    ~TempFolder() { fs::remove_all(path_); }
-    const fs::path& path() const { return path_; }
-    std::size_t entries() const { return std::distance(fs::directory_iterator(path_), fs::directory_iterator()); }
-
-private:
-    fs::path path_;
-};
+/// The tests that write image files, each in a folder of its own.
+using RenderFiles = dqj::test::ScratchFolder;
 
 void checkBall(Variant variant, NormalMethod normals) {
     const Params params = ballParams(variant, normals);
@@ -248,8 +239,7 @@ TEST(RenderImage, NoLoneDarkPixelsOnTheDefaultFractal) {
     EXPECT_LE(loneDarkPixels(result.image), 2);
 }
 
-TEST(RenderImage, DefaultParametersRoundTripThroughFiles) {
-    TempFolder folder;
+TEST_F(RenderFiles, DefaultParametersRoundTripThroughFiles) {
     Params params;
     params.render.width = 160;
     params.render.height = 120;
@@ -257,7 +247,7 @@ TEST(RenderImage, DefaultParametersRoundTripThroughFiles) {
     EXPECT_GT(result.stats.hitPixels, 1000u);
     const Image& image = result.image;
 
-    const std::string png8 = (folder.path() / "default8.png").string();
+    const std::string png8 = (dir_ / "default8.png").string();
     writeImage(image, png8, ImageFormat::Png8);
     const Image read8 = readPng(png8);
     ASSERT_EQ(read8.width, image.width);
@@ -271,7 +261,7 @@ TEST(RenderImage, DefaultParametersRoundTripThroughFiles) {
     }
     EXPECT_LE(worst8, 1.0 / 255.0);
 
-    const std::string png16 = (folder.path() / "default16.png").string();
+    const std::string png16 = (dir_ / "default16.png").string();
     writeImage(image, png16, ImageFormat::Png16);
     const Image read16 = readPng(png16);
     ASSERT_EQ(read16.width, image.width);
@@ -284,7 +274,7 @@ TEST(RenderImage, DefaultParametersRoundTripThroughFiles) {
     EXPECT_LE(worst16, 1.0 / 65535.0 + 1e-6);  // float storage adds ~1e-7
     EXPECT_LT(worst16, worst8 + 1e-9);
 
-    const fs::path exr = folder.path() / "default.exr";
+    const fs::path exr = dir_ / "default.exr";
     writeImage(image, exr.string(), ImageFormat::Exr);
     ASSERT_TRUE(fs::exists(exr));
     EXPECT_GT(fs::file_size(exr), 0u);
@@ -296,18 +286,17 @@ TEST(RenderImage, DefaultParametersRoundTripThroughFiles) {
     EXPECT_EQ(magic[2], 0x31);
     EXPECT_EQ(magic[3], 0x01);
 
-    EXPECT_EQ(folder.entries(), 3u) << "temporary files left behind";
+    EXPECT_EQ(files().size(), 3u) << "temporary files left behind";
 }
 
-TEST(RenderImage, FailedWritesLeaveNothing) {
-    TempFolder folder;
+TEST_F(RenderFiles, FailedWritesLeaveNothing) {
     Image image;
     image.width = 2;
     image.height = 2;
     image.rgba.assign(16, 0.5f);
 
     // A missing folder: a clear message naming the path, and no file.
-    const fs::path missing = folder.path() / "missing" / "x.png";
+    const fs::path missing = dir_ / "missing" / "x.png";
     for (ImageFormat format : {ImageFormat::Png8, ImageFormat::Png16, ImageFormat::Exr}) {
         try {
             writeImage(image, missing.string(), format);
@@ -322,21 +311,21 @@ TEST(RenderImage, FailedWritesLeaveNothing) {
 
     // The target is a folder: the rename fails after the data was written; the temporary
     // file must be gone and the folder untouched.
-    const fs::path occupied = folder.path() / "occupied.png";
+    const fs::path occupied = dir_ / "occupied.png";
     fs::create_directory(occupied);
     EXPECT_THROW(writeImage(image, occupied.string(), ImageFormat::Png8), std::runtime_error);
     EXPECT_TRUE(fs::is_directory(occupied));
-    EXPECT_EQ(folder.entries(), 1u) << "temporary file left behind";
+    EXPECT_EQ(files().size(), 1u) << "temporary file left behind";
 
     // Replacing an existing file works and leaves only that file.
-    const fs::path existing = folder.path() / "existing.png";
+    const fs::path existing = dir_ / "existing.png";
     std::ofstream(existing) << "old";
     writeImage(image, existing.string(), ImageFormat::Png8);
     EXPECT_EQ(readPng(existing.string()).width, 2);
-    EXPECT_EQ(folder.entries(), 2u);
+    EXPECT_EQ(files().size(), 2u);
 
     // Reading something that is not a PNG fails with the path in the message.
-    const fs::path text = folder.path() / "text.png";
+    const fs::path text = dir_ / "text.png";
     std::ofstream(text) << "not a png at all";
     try {
         readPng(text.string());

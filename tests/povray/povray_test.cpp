@@ -86,18 +86,9 @@ const std::string kPreamble = std::string(
                                   "camera { location <0, 0, -5> look_at 0 }\n") +
                               kPrintMacro;
 
-class Povray : public ::testing::Test {
+class Povray : public dqj::test::ScratchFolder {
 protected:
-    void SetUp() override { dir_ = dqj::test::freshTestFolder("dqjulia_povray"); }
-    void TearDown() override {
-        if (!HasFailure()) fs::remove_all(dir_);
-    }
-
-    std::string path(const std::string& name) const { return (dir_ / name).string(); }
-    std::string write(const std::string& name, const std::string& text) {
-        std::ofstream(dir_ / name, std::ios::binary) << text;
-        return path(name);
-    }
+    Povray() { keepWhenFailed_ = true; }  // the scene, its renders and POV-Ray's messages, to look at
 
     /// Runs `povray <arguments>` in the test folder with dqjulia.inc from the source tree on the
     /// library path; no display, no output file unless the arguments ask for one.
@@ -128,8 +119,6 @@ protected:
         if (err) *err = readFile(errPath);
         return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
     }
-
-    fs::path dir_;
 };
 
 /// The lines "TAG rest" of a log, by tag.

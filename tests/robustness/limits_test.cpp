@@ -134,10 +134,10 @@ std::vector<std::string> words(const std::string& text) {
     return result;
 }
 
-class Limited : public ::testing::Test {
+class Limited : public dqj::test::ScratchFolder {
 protected:
     void SetUp() override {
-        dir_ = dqj::test::freshTestFolder("dqjulia_limits");
+        ScratchFolder::SetUp();
         // A copy of the command anyone may run: the build may lie in a 0700 home, and a process
         // limit runs it as another user (who also needs to write the outputs).
         fs::permissions(dir_, fs::perms::all);
@@ -150,7 +150,6 @@ protected:
         fs::create_directories(out_);
         fs::permissions(out_, fs::perms::all);
     }
-    void TearDown() override { fs::remove_all(dir_); }
 
     /// The command `line` (words; OUT is out_, IN is dir_) under `limits`.
     Outcome run(const std::string& line, const Limits& limits = {}, const std::string& input = "/dev/null") {
@@ -209,7 +208,7 @@ protected:
         fs::remove(out_ / command.output);
     }
 
-    fs::path dir_, out_;
+    fs::path out_;
     std::string cli_;
     std::set<std::string> tileNames_;
 };

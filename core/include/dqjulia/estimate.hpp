@@ -77,8 +77,8 @@ DQJ_API double minimumBailout(const Fractal& fractal);
 /// with c_b = 0 and b_0 = direction, grad = (a_n . b_n) / |a_n|^2. Exact, no finite differences.
 DQJ_API glm::dvec3 realPartGradient(const Fractal& fractal, const Quat& start, const Quat directions[3]);
 
+/// The variant's name in the parameter file: "paper", "paper-coupled" or "dual" (the schema's
+/// choices, schema::choiceName; from a name back: schema::choiceIndex).
 DQJ_API std::string_view variantName(Variant variant);
-/// "paper", "paper-coupled" or "dual"; std::nullopt for anything else.
-DQJ_API std::optional<Variant> parseVariant(std::string_view name);
 
 }  // namespace dqj

@@ -8,6 +8,8 @@
 #ifndef DQJULIA_EXPORT_H
 #define DQJULIA_EXPORT_H
 
+/* why: a public header, included by users' programs that do not see core/src/platform; the
+ * compiler's own keywords (__declspec, __attribute__) differ by system. */
 #if defined(_WIN32)
 #if defined(DQJ_STATIC)
 #define DQJ_API

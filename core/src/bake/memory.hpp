@@ -1,8 +1,9 @@
 // memory.hpp - the memory a bake, a mesh or a merge is estimated to take and may take (internal
 // to libdqjulia; code in memory.cpp, which also holds bake.hpp's MemoryLimitError,
 // processMemoryHeadroom, defaultMemoryLimit and formatBytes). Cost: the estimates are a few
-// operations; the limits read a few small files of /proc and /sys (Linux) or ask the job object
-// (Windows).
+// operations; the limits ask the system (platform.hpp: a few small files of /proc and /sys on
+// Linux, the job object on Windows), as does the peak the command's --stats prints
+// (platform::peakMemoryBytes).
 #pragma once
 
 #include <cstdint>
@@ -22,9 +23,5 @@ MemoryModel bakeMemoryModel(const BakeSettings& bake);
 
 /// What a mesh takes beyond its sampled leaves (bakeMesh).
 MemoryModel meshMemoryModel();
-
-/// The process's peak resident memory, in bytes (0 where the system does not say): what the
-/// command's --stats prints.
-std::uint64_t peakMemoryBytes();
 
 }  // namespace dqj

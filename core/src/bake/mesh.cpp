@@ -26,6 +26,7 @@
 #include "bake/level_set.hpp"
 #include "bake/memory.hpp"
 #include "platform/parallel_progress.hpp"
+#include "platform/platform.hpp"
 #include "platform/thread_scratch.hpp"
 
 namespace dqj {
@@ -246,7 +247,7 @@ Mesh bakeMesh(const Params& params, const BakeOptions& options, const ProgressCa
         openvdb::tools::VolumeToMesh mesher(0.0, params.bake.adaptivity);
         mesher(*sampled.grid);
         sampled.grid.reset();
-        releaseFreedMemory();
+        platform::releaseFreedMemory();
         const openvdb::Vec3s* points = mesher.pointList().get();
         mesh.positions.resize(mesher.pointListSize());
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.positions.size()), [&](const auto& range) {

@@ -20,6 +20,7 @@
 #include <tbb/parallel_sort.h>
 
 #include "bake/sparse_sampler.hpp"
+#include "platform/platform.hpp"
 #include "platform/thread_scratch.hpp"
 
 namespace dqj {
@@ -91,7 +92,7 @@ Mesh meshOf(const openvdb::FloatGrid& f) {
     mesher(f);
     // The mesher's own trees were freed as it returned; handed back before the copies below
     // (at 2048^3 the copies came on top of them: 1.96 GB, the bake's peak; now 1.3 GB).
-    releaseFreedMemory();
+    platform::releaseFreedMemory();
     Mesh mesh;
     mesh.points.resize(mesher.pointListSize());
     const openvdb::math::Transform& transform = f.transform();
@@ -462,10 +463,10 @@ openvdb::FloatGrid::Ptr levelSetOfMesh(openvdb::FloatGrid::Ptr f, float bandWidt
     const openvdb::math::Transform::Ptr transform = f->transform().copy();
     const float voxelSize = float(f->voxelSize()[0]);
     f.reset();  // the caller's copy too, if it moved it here: its memory is the band's
-    releaseFreedMemory();
+    platform::releaseFreedMemory();
     if (stop) return nullptr;
     auto homes = std::make_unique<const Homes>(mesh);  // freed before the band, which does not use it
-    releaseFreedMemory();
+    platform::releaseFreedMemory();
 
     // The leaves that may hold near voxels: the homes and their neighbours.
     std::vector<std::uint64_t> leaves;
@@ -520,7 +521,7 @@ openvdb::FloatGrid::Ptr levelSetOfMesh(openvdb::FloatGrid::Ptr f, float bandWidt
         near.resize(kept);
         near.shrink_to_fit();
     }
-    releaseFreedMemory();
+    platform::releaseFreedMemory();
 
     // The near voxels' leaves, by key (`leaves` is sorted).
     auto nearLeaf = [&](std::uint64_t key) -> const NearLeaf* {

@@ -10,7 +10,6 @@
 #include <vector>
 
 #include <glm/common.hpp>
-#include <malloc.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <glm/geometric.hpp>
@@ -20,6 +19,7 @@
 #include "dqjulia/batch.hpp"
 #include "dqjulia/slice.hpp"
 #include "platform/parallel_progress.hpp"
+#include "platform/platform.hpp"
 #include "bake/tile_geometry.hpp"
 
 namespace dqj {
@@ -207,7 +207,7 @@ public:
         }
 
         stats_.prunedLeaves = pruneAwayFromSurface(*tree, f_.background());
-        releaseFreedMemory();
+        platform::releaseFreedMemory();
 
         SampledSurface result;
         result.grid = openvdb::FloatGrid::create(tree);
@@ -550,14 +550,6 @@ double bakeVoxelSize(const Params& params) {
     const BakeRegion region(params);
     const glm::dvec3 size = region.box().max - region.box().min;
     return std::max(size.x, std::max(size.y, size.z)) / params.bake.resolution;
-}
-
-void releaseFreedMemory() {
-#ifdef _WIN32
-    _heapmin();  // the C runtime's heap, to the system
-#else
-    malloc_trim(0);
-#endif
 }
 
 SampledSurface sampleSurface(const Params& params, const BakeOptions& options, const MemoryModel& memory,

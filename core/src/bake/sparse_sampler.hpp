@@ -103,11 +103,6 @@ double bakeVoxelSize(const Params& params);
 /// faces close. Tiles cut this box (tile_geometry.hpp).
 openvdb::CoordBBox bakeIndexBox(const Params& params);
 
-/// Gives the pages of freed blocks back to the system (malloc_trim). glibc keeps them
-/// otherwise, scattered between live blocks in its per-thread arenas, and the next stage of a
-/// bake would add its memory to theirs.
-void releaseFreedMemory();
-
 /// Samples f for `params` (validated); with options.tile, only the tile's window of the whole
 /// bake's grid (tileWindow). Throws MemoryLimitError (before sampling) and Cancelled.
 /// Uses progress stages Classifying in [0, split] and Sampling in [split, end].

@@ -9,12 +9,12 @@
 // so a full disk or a failing device is an error ("No space left on device"), never a
 // truncated file. commit() either replaces an existing file (Existing::Replace) or refuses to
 // (Existing::Keep, atomically: a file created meanwhile by someone else is never replaced).
-// Names are UTF-8 (file_names.hpp). Windows has no unnamed files: there the hidden name is always
-// used, held open so that no other writer removes it, and published with MoveFileExW.
+// Names are UTF-8 (platform.hpp). Windows has no unnamed files: there the hidden name is always
+// used, held open so that no other writer removes it, and published with MoveFileExW. The steps on
+// the file system are platform::PendingFile's; the checks and their order are here.
 // AtomicFileSet publishes the several files of one run together: all of them or none.
 #pragma once
 
-#include <compare>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -27,17 +27,6 @@
 
 namespace dqj {
 
-/// What identifies a file whatever names it (symbolic and hard links included): device and
-/// inode on POSIX, volume serial number and file index on Windows.
-struct FileIdentity {
-    std::uint64_t device = 0;
-    std::uint64_t index = 0;
-    auto operator<=>(const FileIdentity&) const = default;
-};
-/// The identity of the existing file at `path` (through symbolic links), or nullopt when
-/// nothing is there or it cannot be looked at.
-std::optional<FileIdentity> fileIdentity(const std::string& path);
-
 /// Why Windows cannot hold a file at `path` under the name given, or "": a component that is a
 /// reserved device name (CON, PRN, AUX, NUL, COM1-COM9, LPT1-LPT9, COM and LPT with a superscript
 /// 1-3, CONIN$, CONOUT$; any case, with any extension, spaces before the extension too), holds a
@@ -47,6 +36,9 @@ std::optional<FileIdentity> fileIdentity(const std::string& path);
 /// (\\server\share) are the path's root, not components. Pure string logic, so it is tested on
 /// every platform; the writers apply it on Windows.
 std::string windowsNameProblem(const std::string& path);
+/// Why this system cannot hold a file at `path` under the name given, or "": windowsNameProblem()
+/// on Windows; nothing on POSIX, where a name is bytes (its length is checked when it is written).
+std::string systemNameProblem(const std::string& path);
 
 class AtomicFile {
 public:

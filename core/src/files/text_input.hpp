@@ -1,10 +1,11 @@
-// text_input.hpp - reading text: lines of at most a given length from a file descriptor, and small
-// files whole, with a read error always reported as one (never taken for the end of the input)
-// and a line or file over its limit refused before more than the limit is held in memory.
+// text_input.hpp - reading text: lines of at most a given length from a file descriptor, and
+// whether a small file holds a text, with a read error always reported as one (never taken for the
+// end of the input) and a line or file over its limit refused before more than the limit is held
+// in memory.
 //
-// Internal to libdqjulia (the command uses it too): `eval`'s points on standard input, the
-// /proc and cgroup files the memory guard reads, the include file `povray` compares. Reads go
-// through read() (Windows: _read), one 64 kB buffer per reader; a line is copied once.
+// Internal to libdqjulia (the command uses it too): `eval`'s points on standard input, the include
+// file `povray` compares. Reads go through platform::readSome (read(); Windows: _read), one 64 kB
+// buffer per reader; a line is copied once.
 #pragma once
 
 #include <cstddef>
@@ -42,19 +43,9 @@ private:
     bool ended_ = false;
 };
 
-/// The whole file at `path` (UTF-8, file_names.hpp), or nullopt when there is none. Throws
-/// std::system_error when it cannot be opened or read, and std::runtime_error when it is not a
-/// regular file (a FIFO would block) or has more than `maxBytes` bytes (nothing beyond them is
-/// read).
-std::optional<std::string> readSmallFile(const std::string& path, std::size_t maxBytes);
-
-/// Whether the file at `path` holds exactly `text` (nullopt: there is no such file), read no
-/// further than one byte beyond it. Throws as readSmallFile().
+/// Whether the file at `path` (UTF-8, platform.hpp) holds exactly `text` (nullopt: there is no such
+/// file), read no further than one byte beyond it. Throws std::system_error when it cannot be
+/// opened or read, and std::runtime_error when it is not a regular file (a FIFO would block).
 std::optional<bool> fileHolds(const std::string& path, std::string_view text);
-
-/// The rest of the first line of the file at `path` (at most 1 MiB) that starts with `prefix`
-/// ("VmSize:" in /proc/self/status), or nullopt when there is no such line or no such file (no
-/// /proc, no cgroup here). Throws as readSmallFile().
-std::optional<std::string> lineStartingWith(const std::string& path, const std::string& prefix);
 
 }  // namespace dqj

@@ -10,7 +10,7 @@
 #include <openvdb/io/Archive.h>
 #include <openvdb/io/Stream.h>
 
-#include "files/file_names.hpp"
+#include "platform/platform.hpp"
 #include "files/message_text.hpp"
 
 // Without Blosc, OpenVDB would throw only at the first leaf it compresses, in every bake.
@@ -112,7 +112,7 @@ VdbContents readChecked(const std::string& path, bool metadataOnly) {
     auto fail = [&](const std::string& reason) {
         return std::runtime_error("cannot read '" + inputExcerpt(path) + "': " + reason);
     };
-    const std::filesystem::path name = pathFromUtf8(path);  // UTF-8, on Windows too (file_names.hpp)
+    const std::filesystem::path name = platform::pathFromUtf8(path);  // UTF-8, on Windows too (platform.hpp)
     std::ifstream in(name, std::ios::binary);
     if (!in) throw fail(std::strerror(errno));
     std::error_code error;

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <limits>
 
+#include "dqjulia/schema.hpp"
+
 namespace dqj {
 namespace {
 
@@ -133,20 +135,6 @@ glm::dvec3 realPartGradient(const Fractal& fractal, const Quat& start, const Qua
     return glm::dvec3(dot4(a, b[0]), dot4(a, b[1]), dot4(a, b[2])) / normSquared;
 }
 
-std::string_view variantName(Variant variant) {
-    switch (variant) {
-        case Variant::Paper: return "paper";
-        case Variant::PaperCoupled: return "paper-coupled";
-        case Variant::Dual: return "dual";
-    }
-    return "unknown";
-}
-
-std::optional<Variant> parseVariant(std::string_view name) {
-    if (name == "paper") return Variant::Paper;
-    if (name == "paper-coupled") return Variant::PaperCoupled;
-    if (name == "dual") return Variant::Dual;
-    return std::nullopt;
-}
+std::string_view variantName(Variant variant) { return schema::choiceName("fractal.variant", int(variant)); }
 
 }  // namespace dqj

@@ -8,12 +8,10 @@
 #include <cmath>
 #include <cstring>
 
-#include <unistd.h>
-
 #include "files/atomic_file.hpp"
 #include "dqjulia/param_file.hpp"
 #include "dqjulia/schema.hpp"
-#include "files/file_names.hpp"
+#include "platform/platform.hpp"
 #include "params/json_text.hpp"
 #include "params/param_check.hpp"
 
@@ -433,7 +431,7 @@ Params readDocument(const Json& document, const std::string& source, Validation 
 Params loadParams(const std::string& path, Validation validation) {
     const std::string source = "parameter file '" + inputExcerpt(path) + "'";
     auto fail = [&](const std::string& reason) { return ParamError("", "cannot read " + source + ": " + reason); };
-    const int fd = openForReading(path);
+    const int fd = platform::openForReading(path);
     if (fd < 0) throw fail(std::strerror(errno));
     // Read at most one byte beyond the limit, so a never-ending file (/dev/zero, a stalled
     // pipe's writer) cannot grow the buffer without bound. A signal (Ctrl-C) ends the read.
@@ -441,12 +439,12 @@ Params loadParams(const std::string& path, Validation validation) {
     char chunk[65536];
     int error = 0;
     while (text.size() <= kMaxParamsBytes) {
-        const ssize_t got = ::read(fd, chunk, sizeof chunk);
+        const std::int64_t got = platform::readSome(fd, chunk, sizeof chunk);
         if (got < 0) error = errno;
         if (got <= 0) break;
         text.append(chunk, std::size_t(got));
     }
-    ::close(fd);
+    platform::closeFile(fd);
     if (error == EINTR) throw fail("interrupted");
     if (error == EISDIR) throw fail(std::strerror(error));  // a folder given as the file: bad input
     // The disk or the network failing is not bad input (exit 1, DQJ_ERROR_IO): a retry may help.

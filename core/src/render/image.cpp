@@ -27,7 +27,7 @@
 #include <half.h>
 
 #include "files/atomic_file.hpp"
-#include "files/file_names.hpp"
+#include "platform/platform.hpp"
 
 namespace dqj {
 namespace {
@@ -348,7 +348,7 @@ Image readPng(const std::string& path) {
     };
     PngRead read;
     PngReadGuard guard{read};
-    read.file = openFile(path, "rb");
+    read.file = platform::openFile(path, "rb");
     if (!read.file) throw fail(std::strerror(errno));
     png_byte signature[8] = {};
     if (std::fread(signature, 1, 8, read.file) != 8 || png_sig_cmp(signature, 0, 8) != 0) throw fail("not a PNG file");

@@ -18,7 +18,7 @@
 #include "dqjulia/coloring.hpp"
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/render.hpp"
-#include "files/file_names.hpp"
+#include "platform/platform.hpp"
 #include "platform/parallel_progress.hpp"
 #include "files/text_input.hpp"
 
@@ -447,11 +447,11 @@ void writeDf3(const DensityGrid& grid, const std::string& path, int bits, Existi
 
 PovrayFiles povrayFiles(const Params& params, const std::string& scenePath, const PovrayWriteOptions& options) {
     namespace fs = std::filesystem;
-    const fs::path scene = pathFromUtf8(scenePath);
+    const fs::path scene = platform::pathFromUtf8(scenePath);
     if (scenePath.empty() || !scene.has_filename())
         throw std::runtime_error(AtomicFile::failureMessage(scenePath, "not a file name"));
     const fs::path folder = scene.parent_path();
-    const std::string stem = utf8FromPath(folder / scene.stem());
+    const std::string stem = platform::utf8FromPath(folder / scene.stem());
     if (params.fractal.iterations > kPovrayMaxIterations && !options.df3)
         throw iterationLimitError(params.fractal.iterations);
     PovrayFiles files;
@@ -461,7 +461,7 @@ PovrayFiles povrayFiles(const Params& params, const std::string& scenePath, cons
         files.df3Scene = stem + "_df3.pov";
         // The DF3 scene names the grid file in a POV-Ray string, which carries printable
         // ASCII only (POV-Ray 3.7 reads strings as ASCII; quotes and backslashes are escapes).
-        const std::string df3Name = utf8FromPath(pathFromUtf8(files.df3).filename());
+        const std::string df3Name = platform::utf8FromPath(platform::pathFromUtf8(files.df3).filename());
         for (const char ch : df3Name)
             if (ch < 0x20 || ch > 0x7e || ch == '"' || ch == '\\')
                 throw ParamError("output.path", "'" + inputExcerpt(scenePath) +
@@ -470,7 +470,7 @@ PovrayFiles povrayFiles(const Params& params, const std::string& scenePath, cons
                                                     "' in a POV-Ray string, which carries only printable ASCII "
                                                     "characters without \" and \\; rename the scene");
     }
-    if (options.copyInclude) files.include = utf8FromPath(folder / "dqjulia.inc");
+    if (options.copyInclude) files.include = platform::utf8FromPath(folder / "dqjulia.inc");
     return files;
 }
 
@@ -491,7 +491,7 @@ std::vector<std::string> writePovray(const Params& params, const std::string& sc
     if (options.df3) {
         grid = bakeDensityGrid(params, options.df3Resolution, progress);
         PovraySceneOptions df3Options = sceneOptions;
-        df3Options.df3Name = utf8FromPath(pathFromUtf8(files.df3).filename());
+        df3Options.df3Name = platform::utf8FromPath(platform::pathFromUtf8(files.df3).filename());
         df3Options.grid = &grid;
         df3SceneText = povrayScene(params, df3Options);
     }

@@ -16,7 +16,7 @@
 #include "files/atomic_file.hpp"
 #include "bake/attribute_reach.hpp"
 #include "dqjulia/version.h"
-#include "files/file_names.hpp"
+#include "platform/platform.hpp"
 #include "bake/level_set.hpp"
 #include "bake/sparse_sampler.hpp"
 #include "bake/tile_geometry.hpp"
@@ -134,7 +134,7 @@ MergeStats mergeTiles(const std::vector<std::string>& tiles, const std::string& 
         if (progress && !progress(0.9 * double(index) / double(headers.size()))) throw Cancelled();
         const TileHeader& header = headers[index];
         VdbContents contents = readVdbFile(header.path);
-        stats.tileBytes += std::filesystem::file_size(pathFromUtf8(header.path));
+        stats.tileBytes += std::filesystem::file_size(platform::pathFromUtf8(header.path));
         auto tileSurface = openvdb::gridPtrCast<openvdb::FloatGrid>(findGrid(contents, "surface"));
         if (!tileSurface || tileSurface->getGridClass() != openvdb::GRID_LEVEL_SET)
             throw ParamError("tiles",
@@ -167,7 +167,7 @@ MergeStats mergeTiles(const std::vector<std::string>& tiles, const std::string& 
                 openvdb::tools::compReplace(*openvdb::gridPtrCast<openvdb::FloatGrid>(into),
                                             *openvdb::gridPtrCast<openvdb::FloatGrid>(part));
         }
-        releaseFreedMemory();  // the tile's nodes that the union did not take
+        platform::releaseFreedMemory();  // the tile's nodes that the union did not take
     }
     openvdb::tools::pruneLevelSet(surface->tree());
     stats.tiles = int(headers.size());
