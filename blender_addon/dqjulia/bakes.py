@@ -24,7 +24,7 @@ import uuid
 import bpy
 from bpy.app.handlers import persistent
 
-from . import core_state
+from . import core_state, props
 
 ADDON_DIR = os.path.dirname(os.path.abspath(__file__))
 BAKE_KIND = "dqjulia_bake"  # custom property on baked objects: "volume", "mesh", "sequence"
@@ -472,9 +472,11 @@ _HANDLERS = (
 def register():
     for name, handler in _HANDLERS:
         getattr(bpy.app.handlers, name).append(handler)
+    props.volume_look_changed = apply_volume_look
 
 
 def unregister():
+    props.volume_look_changed = None
     for name, handler in _HANDLERS:
         handlers = getattr(bpy.app.handlers, name)
         if handler in handlers:

@@ -247,10 +247,15 @@ VOLUME_LOOK_ITEMS = [
 ]
 
 
-def _volume_look_changed(settings, _context):
-    from . import bakes  # bakes imports core_state, which imports this module
+# What re-makes an object's baked volumes in a new look: bakes.apply_volume_look, set by bakes.py
+# when it registers (bakes imports core_state, which imports this module, so this module cannot
+# import bakes).
+volume_look_changed = None
 
-    bakes.apply_volume_look(settings.id_data)
+
+def _volume_look_changed(settings, _context):
+    if volume_look_changed is not None:
+        volume_look_changed(settings.id_data)
 
 
 _axes = FIELDS["slice.axes"]["default"].split(",")
