@@ -249,6 +249,7 @@ class Job:
         self._progress: Optional[native.Progress] = None
         self._cancel = threading.Event()
         self._thread: Optional[threading.Thread] = None
+        self._held = False  # in _active (held for a modal operator, or started)
         self.started = time.monotonic()
         self.finished: Optional[float] = None
 
@@ -294,8 +295,13 @@ class Job:
 
     def cancel(self) -> None:
         """Asks the work to stop; safe from any thread. The native call returns at its next
-        progress report."""
+        progress report; a held job that never started is cancelled at once."""
         self._cancel.set()
+        with _lock:
+            if self._held and self._thread is None:
+                self._held = False
+                _active.remove(self)
+                self.state, self.error, self.finished = Job.CANCELLED, "cancelled", time.monotonic()
         progress = self._progress
         if progress is not None:
             progress.cancel()
@@ -310,6 +316,7 @@ class Job:
 
     def run(self) -> str:
         """Runs every task in the calling thread (the worker, or the main thread for scripts)."""
+        self.started = time.monotonic()
         try:
             context = native.Context()
             try:
@@ -353,18 +360,33 @@ class Job:
             self.finished = time.monotonic()
         return self.state
 
-    def start(self) -> None:
-        """Runs the tasks in a worker thread; poll finished_running from the main thread."""
+    def hold(self) -> None:
+        """Counts the job as active (active_jobs, the panels, cancel_all) before its worker
+        starts: a modal operator starts it at its first timer tick (modal_job.py says why)."""
         with _lock:
-            _active.append(self)
-        self._thread = threading.Thread(target=self._thread_main, name="dqjulia-" + self.label, daemon=True)
-        self._thread.start()
+            if not self._held:
+                self._held = True
+                _active.append(self)
+
+    def start(self) -> None:
+        """Runs the tasks in a worker thread; poll finished_running from the main thread. A
+        cancelled job does not start."""
+        with _lock:
+            if self.state != Job.RUNNING or self._thread is not None:
+                return
+            if not self._held:
+                self._held = True
+                _active.append(self)
+            thread = threading.Thread(target=self._thread_main, name="dqjulia-" + self.label, daemon=True)
+            self._thread = thread
+        thread.start()
 
     def _thread_main(self) -> None:
         try:
             self.run()
         finally:
             with _lock:
+                self._held = False
                 if self in _active:
                     _active.remove(self)
 

@@ -18,6 +18,7 @@ from bpy.props import BoolProperty, EnumProperty, StringProperty
 from bpy_extras.io_utils import ExportHelper, ImportHelper
 
 from . import animation, bakes, core_state, jobs, native, osl, props
+from .modal_job import ModalJob
 
 PRESET_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "presets")
 
@@ -272,8 +273,9 @@ class DQJULIA_OT_collection_edit(_NeedsDQJuliaObject, bpy.types.Operator):
 # Bakes
 
 
-class _BakeOperator:
-    """Shared by the bake operators: start the job, poll it, conclude on the main thread."""
+class _BakeOperator(ModalJob):
+    """Shared by the bake operators: make the job, run it (modal_job.py), build the result on
+    the main thread."""
 
     bl_options = {"REGISTER", "UNDO"}
 
@@ -284,8 +286,6 @@ class _BakeOperator:
         description="Bake in the calling thread and return when done (scripts, tests)",
     )
 
-    _job = None
-    _timer = None
     _source_name = ""
     _cleanup = ()
 
@@ -321,56 +321,32 @@ class _BakeOperator:
         except (native.NativeError, ValueError, OSError) as error:
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
-        self._job = job
         self._source_name = obj.name
-        if self.synchronous or bpy.app.background or context.window is None:
-            job.run()
-            return self._conclude(context)
-        job.start()
-        wm = context.window_manager
-        wm.progress_begin(0, 100)
-        self._timer = wm.event_timer_add(0.1, window=context.window)
-        wm.modal_handler_add(self)
-        self._status(context, job.status_text() + " (Esc to cancel)")
-        return {"RUNNING_MODAL"}
+        synchronous = self.synchronous or bpy.app.background or context.window is None
+        return self.run_job(context, job, synchronous)
 
     def invoke(self, context, _event):
         return self.execute(context)
 
-    def modal(self, context, event):
+    def job_started(self, context):
+        context.window_manager.progress_begin(0, 100)
+        self._status(context, self._job.status_text() + " (Esc to cancel)")
+
+    def job_ticked(self, context):
         job = self._job
-        if event.type == "ESC" and event.value == "PRESS":
-            job.cancel()
+        context.window_manager.progress_update(int(100 * job.fraction))
+        if job.cancel_requested:
             self._status(context, "%s: cancelling..." % job.label)
-            return {"RUNNING_MODAL"}
-        if event.type == "TIMER":
-            context.window_manager.progress_update(int(100 * job.fraction))
-            if job.cancel_requested:
-                self._status(context, "%s: cancelling..." % job.label)
-            else:
-                self._status(context, job.status_text() + " (Esc to cancel)")
-            _redraw_progress(context)
-            if job.finished_running:
-                job.join()
-                self._stop(context)
-                return self._conclude(context)
-        return {"PASS_THROUGH"}
+        else:
+            self._status(context, job.status_text() + " (Esc to cancel)")
+        _redraw_progress(context)
 
-    def cancel(self, context):
-        # Blender is closing the operator (e.g. the file is being closed): stop the work.
-        if self._job is not None:
-            self._job.cancel()
-            self._job.join()
-            bakes.remove_files(self._cleanup)
-        self._stop(context)
-
-    def _stop(self, context):
-        wm = context.window_manager
-        if self._timer is not None:
-            wm.event_timer_remove(self._timer)
-            self._timer = None
-        wm.progress_end()
+    def job_ended(self, context):
+        context.window_manager.progress_end()
         self._status(context, None)
+
+    def job_closed(self, _context):
+        bakes.remove_files(self._cleanup)
 
     @staticmethod
     def _status(context, text):
@@ -378,7 +354,7 @@ class _BakeOperator:
         if workspace is not None:
             workspace.status_text_set(text)
 
-    def _conclude(self, context):
+    def job_finished(self, context):
         job = self._job
         obj = bpy.data.objects.get(self._source_name)
         if job.state == jobs.Job.DONE and obj is None:

@@ -20,6 +20,7 @@ import bpy
 from bpy.props import BoolProperty, IntProperty
 
 from . import animation, core_state, jobs, native, operators, props
+from .modal_job import ModalJob
 
 COUNT = 9  # a 3 x 3 grid
 MIN_STRENGTH = 0.01  # the library's range of strengths: 0.01 to 1
@@ -176,10 +177,10 @@ def _locks_bits(settings):
     return sum(GROUP_BITS[name] for name in settings.variation_locks)
 
 
-def start_grid(obj, synchronous):
-    """A new grid around the object's current values (replacing and stopping its last one):
-    the job made and started (or run, when `synchronous`). Returns the Grid; its `message`
-    says what went wrong before any work."""
+def new_grid(obj):
+    """A new grid around the object's current values, replacing (and stopping) its last one,
+    with its job made for the Refresh operator to run. Returns the Grid; its `message` says what
+    went wrong before any work (it has no job then)."""
     settings = obj.dqjulia
     document = props.to_document(settings)
     old = _grids.get(obj.name)
@@ -215,11 +216,6 @@ def start_grid(obj, synchronous):
     grid.thumbnails = task.thumbnails
     grid.job = jobs.Job("Variations", [task])
     grid.running = True
-    if synchronous:
-        grid.job.run()
-        conclude(grid)
-    else:
-        grid.job.start()
     return grid
 
 
@@ -301,7 +297,7 @@ def unavailable():
     return None
 
 
-class DQJULIA_OT_variations_refresh(bpy.types.Operator):
+class DQJULIA_OT_variations_refresh(ModalJob, bpy.types.Operator):
     """Find variations of the active DQ Julia object and render their thumbnails in the background (Esc stops)"""
 
     bl_idname = "dqjulia.variations_refresh"
@@ -320,8 +316,8 @@ class DQJULIA_OT_variations_refresh(bpy.types.Operator):
         description="Work in the calling thread and return when done (scripts, tests)",
     )
 
+    timer_step = 0.05
     _grid = None
-    _timer = None
     _name = ""
 
     @classmethod
@@ -336,56 +332,31 @@ class DQJULIA_OT_variations_refresh(bpy.types.Operator):
             return {"CANCELLED"}
         if self.next_seed and obj.name in _grids:
             obj.dqjulia.variation_seed += 1
+        self._grid, self._name = new_grid(obj), obj.name
+        if self._grid.job is None:
+            return self.job_finished(context)
         synchronous = self.synchronous or bpy.app.background or context.window is None
-        grid = start_grid(obj, synchronous)
-        self._grid, self._name = grid, obj.name
-        if grid.job is None or synchronous:
-            return self._finish(context)
-        wm = context.window_manager
-        self._timer = wm.event_timer_add(0.05, window=context.window)
-        wm.modal_handler_add(self)
-        return {"RUNNING_MODAL"}
+        return self.run_job(context, self._grid.job, synchronous)
 
     def invoke(self, context, _event):
         return self.execute(context)
 
-    def modal(self, context, event):
+    def job_superseded(self):
+        return _grids.get(self._name) is not self._grid
+
+    def job_ticked(self, context):
+        if fill_previews(self._grid):
+            _redraw_panels(context)
+
+    def job_finished(self, context):
         grid = self._grid
-        if _grids.get(self._name) is not grid:  # a newer grid replaced this one
-            grid.job.cancel()
-            self._stop(context)
-            return {"CANCELLED"}
-        if event.type == "ESC" and event.value == "PRESS":
-            grid.job.cancel()
-            return {"RUNNING_MODAL"}
-        if event.type == "TIMER":
-            if fill_previews(grid):
-                _redraw_panels(context)
-            if grid.job.finished_running:
-                grid.job.join()
-                self._stop(context)
-                conclude(grid)
-                _redraw_panels(context)
-                return self._finish(context)
-        return {"PASS_THROUGH"}
-
-    def cancel(self, context):
-        if self._grid is not None and self._grid.job is not None:
-            self._grid.job.cancel()
-            self._grid.job.join()
-        self._stop(context)
-
-    def _stop(self, context):
-        if self._timer is not None:
-            context.window_manager.event_timer_remove(self._timer)
-            self._timer = None
-
-    def _finish(self, _context):
-        grid = self._grid
+        if grid.job is not None:
+            conclude(grid)
+            _redraw_panels(context)
         if grid.message and (grid.job is None or grid.job.state == jobs.Job.FAILED):
             self.report({"ERROR"}, grid.message)
             return {"CANCELLED"}
-        if grid.job is not None and grid.job.state == jobs.Job.CANCELLED:
+        if grid.job.state == jobs.Job.CANCELLED:
             self.report({"WARNING"}, grid.message)
             return {"CANCELLED"}
         failed = sum(1 for thumbnail in grid.thumbnails if thumbnail.error)
@@ -396,12 +367,9 @@ class DQJULIA_OT_variations_refresh(bpy.types.Operator):
 def _refresh_around(context, obj):
     """After a pick: the next grid around the object's new values (in the background where
     there is a window)."""
-    if context.window is not None and not bpy.app.background:
-        # The object named, not the context's: the properties editor may still show the original.
-        with context.temp_override(object=obj, active_object=obj):
-            bpy.ops.dqjulia.variations_refresh("INVOKE_DEFAULT", next_seed=False)
-    else:
-        start_grid(obj, synchronous=True)
+    # The object named, not the context's: the properties editor may still show the original.
+    with context.temp_override(object=obj, active_object=obj):
+        bpy.ops.dqjulia.variations_refresh("INVOKE_DEFAULT", next_seed=False)
 
 
 class DQJULIA_OT_variation_apply(bpy.types.Operator):

@@ -1355,6 +1355,16 @@ def case_cancel():
     job = jobs.Job("test", [jobs.VolumeTask(document, os.path.join(CACHE, "cancelled.vdb"))])
     job.cancel()
     check(job.run() == jobs.Job.CANCELLED, "a job cancelled before it starts reports cancelled")
+    # A modal operator holds its job and starts the worker at its first timer tick (modal_job.py).
+    job = jobs.Job("held", [jobs.VolumeTask(document, os.path.join(CACHE, "held.vdb"))], owner=obj.name)
+    job.hold()
+    held = jobs.active_jobs(obj.name) == [job] and not job.finished_running
+    job.cancel()
+    job.start()
+    check(
+        held and job.state == jobs.Job.CANCELLED and job.finished_running and not jobs.active_jobs(obj.name),
+        "a held job counts as active; cancelled before its worker starts, it is cancelled at once and never starts",
+    )
     s.bake_resolution = 640  # long enough to watch on a fast machine; cancelled half-way
     document = props.to_document(s)
     job = jobs.Job("threaded", [jobs.VolumeTask(document, os.path.join(CACHE, "threaded.vdb"))])
