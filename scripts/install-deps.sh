@@ -1,19 +1,28 @@
 #!/usr/bin/env bash
 # Installs the Debian packages dqjulia needs to build and test, if any are missing.
-# Usage: scripts/install-deps.sh [MORE PACKAGES...]   (as root, or with sudo available)
-#        scripts/install-deps.sh --list                 print the packages, one a line
+# Usage: scripts/install-deps.sh [--build|--windows] [MORE PACKAGES...]   (as root, or with sudo)
+#        scripts/install-deps.sh --list [--build|--windows]                print them, one a line
+#   (no group)  every package: building, the Windows cross build and the tests (scripts/test.sh)
+#   --build     building the library, the command and the add-on zip (scripts/quickstart.sh)
+#   --windows   --build and the MinGW-w64 cross compiler (scripts/build-windows.sh)
 # bench/run.sh passes the benchmark comparisons' packages as arguments.
 # The yardstick is a clean Debian 12 (debootstrap's minbase: scripts/check-clean-machine.sh runs
 # both README commands in one), so nothing beyond Debian's required packages is taken for granted:
 # not even Debian's own python3 and its venv module, which a Python from pyenv would hide.
 set -euo pipefail
 
-packages=(
-  python3 python3-venv  # the tests' scripts; the venvs of scripts/bpy-env.sh and scripts/tool-env.sh
+build_packages=(
+  python3 python3-venv  # the build's scripts; the venvs of scripts/bpy-env.sh and scripts/tool-env.sh
   git  # scripts/check-style.sh (the test style.check) reads the changed lines from git
-  build-essential patch cmake pkg-config clang libclang-rt-14-dev ccache
+  build-essential patch cmake pkg-config ccache
   libglm-dev nlohmann-json3-dev libcli11-dev libgtest-dev libfreetype-dev fonts-dejavu-core
   libboost-dev  # headers only: OpenVDB's, built statically by scripts/build-deps.sh with its other libraries
+)
+windows_packages=(
+  g++-mingw-w64-x86-64-posix  # the Windows build (scripts/build-windows.sh)
+)
+test_packages=(
+  clang libclang-rt-14-dev  # the sanitizer and fuzzing build (scripts/test.sh)
   debootstrap   # tests/cleanroom: the add-on's library loaded in a minimal Debian root
   blender  # the bake tests load the VDB files and meshes in the real Blender (tests/blender)
   xvfb xauth glslang-tools  # the add-on's preview in a real Blender window (xvfb-run); its GLSL checked
@@ -22,9 +31,19 @@ packages=(
   povray  # tests/povray evaluate dqjulia.inc and render generated scenes in the real POV-Ray 3.7
   clang-format clang-tidy  # scripts/check-style.sh (the test style.check); ruff comes from scripts/tool-env.sh ruff
   slurm-wlm munge  # tests/farm: a one-node Slurm cluster on localhost runs a frame array and a tiled bake
-  g++-mingw-w64-x86-64-posix wine64  # the Windows build (scripts/build-windows.sh) and its tests under Wine
+  wine64  # the Windows build's tests (tests/windows)
 )
+list=0
 if [ "${1:-}" = --list ]; then
+  list=1
+  shift
+fi
+case "${1:-}" in
+  --build) packages=("${build_packages[@]}"); shift ;;
+  --windows) packages=("${build_packages[@]}" "${windows_packages[@]}"); shift ;;
+  *) packages=("${build_packages[@]}" "${windows_packages[@]}" "${test_packages[@]}") ;;
+esac
+if [ "$list" = 1 ]; then
   printf '%s\n' "${packages[@]}"
   exit 0
 fi

@@ -3,7 +3,7 @@
 # into out/: a picture, an OpenVDB volume, a mesh and a POV-Ray scene (a few seconds).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/install-deps.sh
+scripts/install-deps.sh --build  # the tests' packages (Blender, Wine, Slurm, ...) are scripts/test.sh's
 scripts/build.sh
 mkdir -p out
 build/bin/dqjulia render --force -o out/dqjulia.png

@@ -7,24 +7,32 @@
 # a bounded time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-scripts/install-deps.sh
-# The Python venvs (on a fresh machine about 800 MB of bpy wheels from PyPI: network, not CPU)
-# are made while the static third-party libraries compile; the build's configure step looks for
-# them, so it waits for both.
-venvs_log="$(mktemp)"
-trap 'rm -f "$venvs_log"' EXIT
-(scripts/bpy-env.sh && scripts/tool-env.sh ruff && scripts/tool-env.sh mypy && scripts/tool-env.sh openjd && scripts/tool-env.sh twine && scripts/tool-env.sh auditwheel) >"$venvs_log" 2>&1 &
-venvs=$!
+scripts/install-deps.sh --windows  # what both builds need (after scripts/quickstart.sh: the cross compiler)
+# Meanwhile, the tests' packages (Blender, POV-Ray, Wine, Slurm, clang, ...: on a fresh machine a
+# few minutes of apt) and the Python venvs (about 800 MB of bpy wheels from PyPI and, without a
+# CPython 3.13, a Debian 13 root) are installed in the background: network and disk more than
+# CPU, beside the builds' compiling. The builds' configure steps look for all of them, so when
+# anything was new, both builds are configured again once it is there (seconds: nothing
+# recompiles).
+background_log="$(mktemp)"
+trap 'rm -f "$background_log"' EXIT
+(scripts/install-deps.sh && scripts/bpy-env.sh && scripts/tool-env.sh ruff && scripts/tool-env.sh mypy && scripts/tool-env.sh openjd && scripts/tool-env.sh twine && scripts/tool-env.sh auditwheel) >"$background_log" 2>&1 &
+background=$!
 scripts/build-deps.sh >/dev/null
-if ! wait "$venvs"; then
-  cat "$venvs_log" >&2
-  echo "dqjulia: making the Python venvs failed (scripts/bpy-env.sh, scripts/tool-env.sh)" >&2
-  exit 1
-fi
-cat "$venvs_log"
 scripts/build.sh
 echo "dqjulia: Windows cross build (MinGW-w64)"
 scripts/build-windows.sh
+if ! wait "$background"; then
+  cat "$background_log" >&2
+  echo "dqjulia: installing the tests' packages or making the Python venvs failed (scripts/install-deps.sh, scripts/bpy-env.sh, scripts/tool-env.sh)" >&2
+  exit 1
+fi
+cat "$background_log"
+if grep -q "dqjulia: installing\|making" "$background_log"; then
+  echo "dqjulia: configuring both builds again, now that the new packages and venvs are there"
+  scripts/build.sh >/dev/null
+  scripts/build-windows.sh >/dev/null
+fi
 # Label `long` (tiled bakes at farm sizes, minutes) is run by hand: ctest --test-dir build -L long
 ctest --test-dir build --output-on-failure -j"$(nproc)" -LE long
 
