@@ -16,7 +16,7 @@
 #                    `ctest --test-dir build -L library` after the quickstart)
 #
 # The commit tested is HEAD (uncommitted changes are not in it), checked out as `main`, as CI's
-# clone is. On 2 cores: about 10 minutes for the quickstart, 45 for the tests, more on a busy
+# clone is. On 2 cores: about 14 minutes for the quickstart, 39 for the tests, more on a busy
 # machine (run it with nice). Exit status: 0 if both commands passed. As root.
 set -euo pipefail
 cd "$(dirname "$0")/.."
