@@ -254,7 +254,7 @@ class Fractal:
     def evaluate(self, points: Any) -> numpy.ndarray:
         """Evaluates 8-D points (a then b, s i j k each): an array-like of shape (..., 8). Returns a
         structured array of shape (...) with the fields n (escape iteration, 0 = did not escape),
-        r (the escape norm at exit), ra and rb (|a| and |b| at exit) and de (distance estimate in
+        r (the escape norm at exit), ra and rb (the norms of a and b at exit) and de (distance estimate in
         8-D units). One call into the library for all points."""
         return self._evaluate(points, 8)
 
