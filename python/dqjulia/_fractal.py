@@ -115,7 +115,7 @@ def _merge(base: dict, changes: Mapping) -> dict:
 
 
 class Fractal:
-    """A dual-quaternion Julia fractal: a parameter document (README, "Parameter file") and what
+    """A dual-quaternion Julia fractal: a parameter document (docs/parameter-file.md) and what
     is made from it: point evaluation, renders, OpenVDB bakes and meshes.
 
     The library validates every document and value; a rejected one raises ParameterError (a
@@ -153,7 +153,7 @@ class Fractal:
 
     @classmethod
     def from_file(cls, path: PathLike) -> Fractal:
-        """A fractal from a parameter file (JSON; README, "Parameter file")."""
+        """A fractal from a parameter file (JSON; docs/parameter-file.md)."""
         fractal = cls()
         fractal.load(path)
         return fractal
@@ -471,7 +471,7 @@ def has_feature(name: str) -> bool:
 
 def schema() -> dict[str, Any]:
     """The parameter schema: every key of the parameter document with its type, label, help,
-    default, range and choices (README, "Parameter schema")."""
+    default, range and choices (docs/parameter-file.md, "Parameter schema")."""
     with _native.Context() as context:
         return context.schema()
 
