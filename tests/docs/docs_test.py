@@ -135,6 +135,13 @@ def references(args):
     functions = re.findall(r"DQJ_API [^;]*?\b(dqj_\w+)\(", (ROOT / "core/include/dqjulia/dqjulia.h").read_text(encoding="utf-8"))
     missing = [name for name in functions if name not in api]
     checks["every function of the header (%d) is on the C API page%s" % (len(functions), ": missing " + ", ".join(missing) if missing else "")] = not missing
+    names = subprocess.run([sys.executable, "-c", "import dqjulia; print(' '.join(dqjulia.__all__))"],
+                           env=dict(os.environ, PYTHONPATH=str(ROOT / "python")), capture_output=True,
+                           text=True, check=True).stdout.split()
+    python = (Path(args.out) / "python.html").read_text(encoding="utf-8")
+    missing = [name for name in names if not name.startswith("_") and 'id="dqjulia.%s"' % name not in python]
+    checks["every public name of the Python package (%d) is on the Python API page%s" % (
+        len(names), ": missing " + ", ".join(missing) if missing else "")] = bool(names) and not missing
     return report(checks)
 
 
