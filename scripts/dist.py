@@ -110,12 +110,16 @@ def docs_site(linux_build, stage, out, version):
         infos = sorted(venv.glob("lib/python3*/site-packages/%s-*.dist-info" % component))
         if len(infos) != 1:
             raise DistError("the sphinx venv holds %d copies of %s" % (len(infos), component))
-        licences = sorted(p for p in infos[0].rglob("*") if p.is_file() and p.name.upper().startswith(("LICENSE", "COPYING")))
+        licences = sorted(
+            p for p in infos[0].rglob("*") if p.is_file() and p.name.upper().startswith(("LICENSE", "COPYING"))
+        )
         if not licences:
             raise DistError("%s has no licence file in %s" % (component, infos[0]))
         for licence in licences:
-            notices.append("\n==== %s (%s)\n\n%s" % (infos[0].name[: -len(".dist-info")], licence.name,
-                                                        licence.read_text(encoding="utf-8")))
+            notices.append(
+                "\n==== %s (%s)\n\n%s"
+                % (infos[0].name[: -len(".dist-info")], licence.name, licence.read_text(encoding="utf-8"))
+            )
     (site / "THIRD-PARTY-NOTICES.txt").write_text("".join(notices), encoding="utf-8")
     write_zip(out / (name + ".zip"), folder_members(site), source_date_epoch())
     log("wrote %s.zip" % name)

@@ -106,13 +106,15 @@ class ParameterTable(SphinxDirective):
             if field.get("image_only"):
                 meaning += " (pictures only: a bake does not depend on it)"
             default = "" if "default" not in field else json.dumps(field["default"])
-            rows.append([
-                [literal(field["key"])],
-                [nodes.paragraph(text=field["type"])],
-                [nodes.paragraph(text=allowed(field))],
-                [literal(default)] if default else [],
-                [nodes.paragraph(text=f"{field['label']}: {meaning}")],
-            ])
+            rows.append(
+                [
+                    [literal(field["key"])],
+                    [nodes.paragraph(text=field["type"])],
+                    [nodes.paragraph(text=allowed(field))],
+                    [literal(default)] if default else [],
+                    [nodes.paragraph(text=f"{field['label']}: {meaning}")],
+                ]
+            )
         return [table(["key", "type", "values", "default", "meaning"], rows, [18, 10, 14, 18, 40])]
 
 
@@ -153,7 +155,9 @@ def header_items(text: str) -> list[tuple[str, str]]:
     """The header as ("title" | "prose" | "code", text) items: its comments become prose, a
     `/* ---- Title ---- */` comment a title, its declarations code (include guards and the
     extern "C" lines left out)."""
-    skip = re.compile(r'^(#ifndef DQJULIA_H|#define DQJULIA_H|#endif|#ifdef __cplusplus|extern "C" \{|\}|#include .*)\s*$')
+    skip = re.compile(
+        r'^(#ifndef DQJULIA_H|#define DQJULIA_H|#endif|#ifdef __cplusplus|extern "C" \{|\}|#include .*)\s*$'
+    )
     items: list[tuple[str, str]] = []
     lines = text.splitlines()
     index = 0
@@ -174,9 +178,8 @@ def header_items(text: str) -> list[tuple[str, str]]:
                 comment.append(lines[index])
             body = []
             for part in comment:
-                part = re.sub(r"^\s*/\*+ ?|\s*\*/\s*$", "", part)
-                part = re.sub(r"^\s*\* ?", "", part)
-                body.append(part)
+                bare = re.sub(r"^\s*/\*+ ?|\s*\*/\s*$", "", part)
+                body.append(re.sub(r"^\s*\* ?", "", bare))
             title = re.match(r"^-+ (.*?) -+$", body[0].strip())
             if title:
                 items.append(("title", title.group(1)))
@@ -197,8 +200,11 @@ def inline(text: str) -> list[nodes.Node]:
     parts = text.split("`")
     if len(parts) % 2 == 0:  # an unpaired backquote: all text
         return [nodes.Text(text)]
-    return [nodes.literal(text=part) if odd else nodes.Text(part) for odd, part in
-            ((index % 2 == 1, part) for index, part in enumerate(parts)) if part]
+    return [
+        nodes.literal(text=part) if odd else nodes.Text(part)
+        for odd, part in ((index % 2 == 1, part) for index, part in enumerate(parts))
+        if part
+    ]
 
 
 def prose_nodes(text: str) -> list[nodes.Node]:
@@ -222,7 +228,9 @@ def prose_nodes(text: str) -> list[nodes.Node]:
         if len(items) > 1:
             bullets = nodes.bullet_list()
             for item in items[1:]:
-                bullets += nodes.list_item("", nodes.paragraph("", "", *inline(" ".join(l.strip() for l in item))))
+                bullets += nodes.list_item(
+                    "", nodes.paragraph("", "", *inline(" ".join(line.strip() for line in item)))
+                )
             result.append(bullets)
     return result
 
