@@ -60,6 +60,8 @@ def internal_links():
     found = []
     for page in sorted(DOCS.glob("*.md")):
         text = page.read_text(encoding="utf-8")
+        text = re.sub(r"^ *(`{3,}).*?^ *\1\s*$", "", text, flags=re.S | re.M)  # fenced blocks: code, not links
+        text = re.sub(r"`[^`\n]*`", "", text)  # code spans likewise
         found += [
             (page.name, target)
             for target in re.findall(r"\]\(([^)\s]+)\)", text)
