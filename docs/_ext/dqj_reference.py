@@ -101,6 +101,8 @@ class ParameterTable(SphinxDirective):
         rows = []
         for field in json.loads(text)["fields"]:
             meaning = field["help"]
+            if "choices" in field:
+                meaning += ". " + "; ".join("%s: %s" % (choice["name"], choice["help"]) for choice in field["choices"])
             if field.get("animatable"):
                 meaning += " (may be keyframed)"
             if field.get("image_only"):
