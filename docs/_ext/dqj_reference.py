@@ -73,7 +73,14 @@ def literal(text: str) -> nodes.paragraph:
 
 
 def number(value: float) -> str:
-    return str(int(value)) if float(value).is_integer() else repr(value)
+    """A limit as people write it: 15, 0.5, 1e9, 1e150."""
+    if float(value).is_integer() and abs(value) < 1e7:
+        return str(int(value))
+    if 1e-4 <= abs(value) < 1e7:
+        return repr(float(value))
+    mantissa, exponent = format(float(value), ".15e").split("e")
+    mantissa = mantissa.rstrip("0").rstrip(".")
+    return "%se%d" % (mantissa, int(exponent))
 
 
 def allowed(field: dict) -> str:
