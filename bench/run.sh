@@ -2,7 +2,7 @@
 # bench/run.sh - the benchmark suite in one command: installs what the comparisons need
 # (Google Benchmark, POV-Ray, Mandelbulber 2, GNU time), builds dqjulia in Release with the
 # benchmarks into build-bench/, then runs bench/compare.py, which prints the table of
-# same-run ratios (README, "Performance"). Extra arguments go to compare.py, e.g.
+# same-run ratios (docs/performance.md). Extra arguments go to compare.py, e.g.
 #   bench/run.sh --skip-mesh --bake-resolutions 256,512
 # Not part of the test command: benchmarks are not tests. Takes 10 to 20 minutes on 2 cores.
 set -euo pipefail

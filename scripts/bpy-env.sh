@@ -26,7 +26,7 @@ set -euo pipefail
 
 # The newest release of each series that PyPI has: the floor the manifest admits (4.2, whose LTS
 # support ended in July 2026), the LTS series 4.5 and 5.2, and the newest release, 5.3. 5.0 and
-# 5.1 were ordinary releases, each replaced by the next after four months (README, "Supported
+# 5.1 were ordinary releases, each replaced by the next after four months (docs/blender.md, "Supported
 # Blender versions").
 versions=(4.2.23 4.5.15 5.2.4 5.3.0)
 cache="${DQJ_BPY_CACHE:-${XDG_CACHE_HOME:-$HOME/.cache}/dqjulia/bpy}"

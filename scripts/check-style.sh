@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Checks the code against the project's style: clang-format (.clang-format) on C and C++,
-# ruff (ruff.toml: lint and format) on the Python of blender_addon/, python/, scripts/ and tests/,
+# ruff (ruff.toml: lint and format) on the Python of blender_addon/, docs/, python/, scripts/ and tests/,
 # mypy (mypy.ini) on the typed modules, clang-tidy (.clang-tidy) on C and C++ sources with
 # build/compile_commands.json, and the layout of core/src (scripts/check-layout.py: includes between
 # its folders run one way).
@@ -50,7 +50,7 @@ missing() {  # the project's rule for a missing tool (tests/script_support.cmake
 have() { command -v "$1" >/dev/null 2>&1; }
 
 is_cxx() { case "$1" in *.c | *.cpp | *.h | *.hpp) return 0 ;; esac; return 1; }
-is_python() { case "$1" in blender_addon/*.py | python/*.py | scripts/*.py | tests/*.py) return 0 ;; esac; return 1; }
+is_python() { case "$1" in blender_addon/*.py | docs/*.py | python/*.py | scripts/*.py | tests/*.py) return 0 ;; esac; return 1; }
 
 # The files to check and, unless --all, the lines changed in each ("FIRST:LAST" ranges).
 declare -A ranges=()

@@ -13,6 +13,9 @@ command's own build/ and build-windows/):
   dqjulia_blender-VERSION-windows-x64.zip
   index.json                              the extension repository (scripts/extension-repo.py)
   *.whl, dqjulia-VERSION.tar.gz           the wheels and the sdist (scripts/build-wheels.py)
+  dqjulia-VERSION-docs.zip                the documentation site (scripts/build-docs.sh on the Linux
+                                          build), with LICENSE and the notices of Sphinx's and the
+                                          theme's files it carries
   THIRD-PARTY.json                        the component list of both targets
   SHA256SUMS                              of every other file, as sha256sum writes it
 
@@ -89,6 +92,39 @@ def sha256(path):
     return digest.hexdigest()
 
 
+# The packages whose files the built site carries (Sphinx's search and basic theme, Furo and the
+# base it builds on, Pygments' highlighting styles): their licences go into the site's notices.
+SITE_COMPONENTS = ("sphinx", "furo", "sphinx_basic_ng", "pygments")
+
+
+def docs_site(linux_build, stage, out, version):
+    """dqjulia-VERSION-docs.zip: the site built from the Linux build's command, one folder."""
+    name = "dqjulia-%s-docs" % version
+    site = stage / name
+    run("bash", SOURCE / "scripts" / "build-docs.sh", linux_build, site)
+    (site / ".buildinfo").unlink(missing_ok=True)  # Sphinx's incremental-build record (names this machine's paths)
+    shutil.copyfile(SOURCE / "LICENSE", site / "LICENSE")
+    venv = Path(run("bash", SOURCE / "scripts" / "tool-env.sh", "sphinx", "--print").strip()).parent.parent
+    notices = ["The documentation site carries files of these packages, under their licences:\n"]
+    for component in SITE_COMPONENTS:
+        infos = sorted(venv.glob("lib/python3*/site-packages/%s-*.dist-info" % component))
+        if len(infos) != 1:
+            raise DistError("the sphinx venv holds %d copies of %s" % (len(infos), component))
+        licences = sorted(
+            p for p in infos[0].rglob("*") if p.is_file() and p.name.upper().startswith(("LICENSE", "COPYING"))
+        )
+        if not licences:
+            raise DistError("%s has no licence file in %s" % (component, infos[0]))
+        for licence in licences:
+            notices.append(
+                "\n==== %s (%s)\n\n%s"
+                % (infos[0].name[: -len(".dist-info")], licence.name, licence.read_text(encoding="utf-8"))
+            )
+    (site / "THIRD-PARTY-NOTICES.txt").write_text("".join(notices), encoding="utf-8")
+    write_zip(out / (name + ".zip"), folder_members(site), source_date_epoch())
+    log("wrote %s.zip" % name)
+
+
 def make(args, out, stage, version):
     builds = {"linux-x64": args.linux_build, "windows-x64": args.windows_build}
     for platform, build in builds.items():
@@ -132,6 +168,9 @@ def make(args, out, stage, version):
             "--out",
             out,
         )
+
+    log("building the documentation site (scripts/build-docs.sh)")
+    docs_site(args.linux_build, stage, out, version)
 
     listing = {"project": "dqjulia", "version": version, "targets": {}}
     for platform, build in builds.items():

@@ -12,7 +12,7 @@ made if missing), or from --tool. Each zip first passes the same tool's `validat
 
 An artist adds DIR's URL (https://..., or file:///studio/share/dqjulia) under Preferences > Get
 Extensions > Repositories; Blender downloads index.json, offers the zip of its own platform, and
-offers a newer version as an update once DIR holds it (README, "Installing from the repository").
+offers a newer version as an update once DIR holds it (docs/blender.md, "Installing").
 
 DIR may hold other files (a release folder does): server-generate lists every .zip in the folder
 it is given, so it runs in a private folder holding only these zips, and its index.json (whose

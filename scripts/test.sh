@@ -9,14 +9,14 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh --windows  # what both builds need (after scripts/quickstart.sh: the cross compiler)
 # Meanwhile, the tests' packages (Blender, POV-Ray, Wine, Slurm, clang, ...: on a fresh machine a
-# few minutes of apt) and the Python venvs (about 800 MB of bpy wheels from PyPI and, without a
-# CPython 3.13, a Debian 13 root) are installed in the background: network and disk more than
-# CPU, beside the builds' compiling. The builds' configure steps look for all of them, so when
+# few minutes of apt) and the Python venvs (about 800 MB of bpy wheels from PyPI, Sphinx for the
+# documentation's tests and, without a CPython 3.13, a Debian 13 root) are installed in the
+# background: network and disk more than CPU, beside the builds' compiling. The builds' configure steps look for all of them, so when
 # anything was new, both builds are configured again once it is there (seconds: nothing
 # recompiles).
 background_log="$(mktemp)"
 trap 'rm -f "$background_log"' EXIT
-(scripts/install-deps.sh && scripts/bpy-env.sh && scripts/tool-env.sh ruff && scripts/tool-env.sh mypy && scripts/tool-env.sh openjd && scripts/tool-env.sh twine && scripts/tool-env.sh auditwheel) >"$background_log" 2>&1 &
+(scripts/install-deps.sh && scripts/bpy-env.sh && scripts/tool-env.sh ruff && scripts/tool-env.sh mypy && scripts/tool-env.sh openjd && scripts/tool-env.sh twine && scripts/tool-env.sh auditwheel && scripts/tool-env.sh sphinx) >"$background_log" 2>&1 &
 background=$!
 scripts/build-deps.sh >/dev/null
 scripts/build.sh

@@ -7,6 +7,9 @@
 #   openjd      Open Job Description's reference runner for tests/farm (openjd-cli, about 20 MB)
 #   auditwheel  PyPA's checker of a Linux wheel's platform tag, for tests/python (about 10 MB)
 #   twine       PyPA's uploader, whose `twine check` tests/python runs on the wheels and the sdist (about 15 MB)
+#   sphinx      the documentation site's builder (docs/, tests/docs, scripts/release.sh): Sphinx with
+#               MyST-Parser for the Markdown pages and the Furo theme, pinned together (about 60 MB);
+#               its program is sphinx-build
 #
 #   scripts/tool-env.sh TOOL           make the venv if it is missing (an existing one costs nothing)
 #   scripts/tool-env.sh TOOL --print   print the tool's program (installs nothing; exit 1 if absent)
@@ -16,7 +19,7 @@
 # `TOOL --version` fails is made again.
 set -euo pipefail
 
-usage() { echo "usage: tool-env.sh ruff|mypy|openjd|auditwheel|twine [--print]" >&2; exit 2; }
+usage() { echo "usage: tool-env.sh ruff|mypy|openjd|auditwheel|twine|sphinx [--print]" >&2; exit 2; }
 [ $# -ge 1 ] || usage
 tool="$1"
 shift
@@ -26,11 +29,14 @@ case "$tool" in
   openjd) version=0.8.0 package="openjd-cli==$version" cache="${DQJ_OPENJD_CACHE:-}" ;;
   auditwheel) version=6.8.2 package="auditwheel==$version" cache="${DQJ_AUDITWHEEL_CACHE:-}" ;;
   twine) version=6.2.0 package="twine==$version" cache="${DQJ_TWINE_CACHE:-}" ;;
+  # One venv of three pinned packages: the folder's name carries every pin.
+  sphinx) version=9.0.4-myst5.0.0-furo2025.12.19 program_name=sphinx-build
+          package="sphinx==9.0.4 myst-parser==5.0.0 furo==2025.12.19" cache="${DQJ_SPHINX_CACHE:-}" ;;
   *) usage ;;
 esac
 cache="${cache:-${XDG_CACHE_HOME:-$HOME/.cache}/dqjulia/$tool}"
 venv="$cache/$version"
-program="$venv/bin/$tool"
+program="$venv/bin/${program_name:-$tool}"
 
 if [ "${1:-}" = "--print" ]; then
   echo "$program"
@@ -48,7 +54,8 @@ tmp="$(mktemp -d "$cache/.$version.XXXXXX")"
 trap 'rm -rf "$tmp"' EXIT
 python3 -m venv "$tmp/venv"
 # `python -m pip`: pip's own #! line would name the temporary folder after the move.
-"$tmp/venv/bin/python" -m pip install --quiet --no-input --disable-pip-version-check "$package"
+# shellcheck disable=SC2086  # $package: one or more requirements
+"$tmp/venv/bin/python" -m pip install --quiet --no-input --disable-pip-version-check $package
 rm -rf "$venv"
 mv "$tmp/venv" "$venv"
 # A Python entry point's #! line names the venv's python: after the move, point it there (ruff's

@@ -3,7 +3,7 @@
 In Blender every property of a DQ Julia object can be keyframed. Bake Sequence takes each
 frame's values from Blender itself (scene.frame_set, so F-curves, drivers and NLA all apply),
 and bakes a document holding that frame's values. The parameter file animates four things
-(README "Animation"): fractal.c, fractal.iterations, fractal.bailout and
+(docs/baking.md, "Animation"): fractal.c, fractal.iterations, fractal.bailout and
 slice.rotations[i].degrees; export writes the keys of those F-curves, import makes F-curves
 from the file's keys. Interpolation: the file's "linear" is Blender's LINEAR; its "smooth"
 (a monotone cubic, never overshooting) is written for and read as Blender's BEZIER with

@@ -359,7 +359,7 @@ for _index, _axis in enumerate("xyz"):
     )
 DQJuliaSettings = _group(
     "DQJuliaSettings",
-    'Everything the parameter file holds (README "Parameter file"), plus the preview\'s options.',
+    'Everything the parameter file holds (docs/parameter-file.md), plus the preview\'s options.',
     _settings,
 )
 

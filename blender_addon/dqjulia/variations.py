@@ -25,7 +25,7 @@ from .modal_job import ModalJob
 COUNT = 9  # a 3 x 3 grid
 MIN_STRENGTH = 0.01  # the library's range of strengths: 0.01 to 1
 GROUP_BITS = {name: native.GROUPS[name] for name, _label, _help in props.VARIATION_GROUP_ITEMS}
-STRENGTH_WORDS = (  # README "Variations of a fractal you like", docs/variations.md
+STRENGTH_WORDS = (  # docs/examples.md "Variations of a fractal you like", docs/variations.md
     (0.05, "tiny", "details move"),
     (0.15, "small", "a close relative"),
     (0.3, "medium", "a sibling"),

@@ -118,7 +118,7 @@ Runner addBakeCommand(CLI::App& app) {
     auto flags = std::make_shared<BakeFlags>();
     CLI::App* command = app.add_subcommand(
         "bake",
-        "Bake an OpenVDB file: level set \"surface\", fog volume \"density\" and attribute grids (README: Baking)");
+        "Bake an OpenVDB file: level set \"surface\", fog volume \"density\" and attribute grids (docs: Baking)");
     flags->addTo(*command, BakeCommand::Bake);
     return [flags] { return reportErrors("bake", [&] { return runBake(*flags); }); };
 }

@@ -82,7 +82,7 @@ void BakeFlags::addTo(CLI::App& command, BakeCommand kind) {
     if (kind != BakeCommand::Mesh)
         command.add_option("--tiles", tiles,
                            "Bake in AxBxC tiles on the whole bake's grid, into NAME.tile_K.vdb (K from 1, x fastest); "
-                           "dqjulia merge joins them (README: Baking on a farm)");
+                           "dqjulia merge joins them (docs: Baking and farms)");
     if (kind == BakeCommand::Farm) {
         command.add_flag("-f,--force", force, "Overwrite the script files");
         return;

@@ -100,7 +100,9 @@ CLI::Validator existingFile() {
 }
 
 void FractalOptions::addTo(CLI::App& command) {
-    command.add_option("-p,--params", paramsFile, "Parameter file (JSON, see README); flags override its values")
+    command
+        .add_option("-p,--params", paramsFile,
+                    "Parameter file (JSON, see docs: Parameter file); flags override its values")
         ->check(existingFile());
     schemaOption(command, "--c", "fractal.c", constant);
     schemaOption(command, "--variant", "fractal.variant", variant);

@@ -77,7 +77,7 @@ int runMerge(const MergeFlags& flags) {
 Runner addMergeCommand(CLI::App& app) {
     auto flags = std::make_shared<MergeFlags>();
     CLI::App* command = app.add_subcommand(
-        "merge", "Merge the tiles of dqjulia bake --tiles into the one-piece bake's file (README: Baking on a farm)");
+        "merge", "Merge the tiles of dqjulia bake --tiles into the one-piece bake's file (docs: Baking and farms)");
     command->add_option("tiles", flags->inputs, "The tiles: NAME.tile_*.vdb (every tile of one bake, any order)");
     command->add_option("-o,--output", flags->bake.output, "The merged OpenVDB file (.vdb)")->required();
     command->add_option("--tiles", flags->bake.tiles,

@@ -11,7 +11,7 @@ namespace dqj::cli {
 Runner addSchemaCommand(CLI::App& app) {
     app.add_subcommand("schema",
                        "Print the parameter file's schema as JSON: every key with its type, label, help,\n"
-                       "default, range and choices (README \"Parameter schema\")");
+                       "default, range and choices (docs: Parameter file)");
     return [] {
         return reportErrors("schema", [] {
             std::cout << schema::schemaJson() << std::flush;

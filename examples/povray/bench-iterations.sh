@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# How POV-Ray's cost grows with the iteration count N (the README's table): dqjulia.inc builds
+# How POV-Ray's cost grows with the iteration count N (docs/povray.md's table): dqjulia.inc builds
 # a chain of N + 2 functions, so parsing and each evaluation should grow linearly in N.
 #
 #   examples/povray/bench-iterations.sh [N ...]     (default 15 30 60 120 240; build dqjulia first)

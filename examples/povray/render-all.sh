@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Renders the POV-Ray examples and prints a table of their times (the README's table).
+# Renders the POV-Ray examples and prints a table of their times (docs/povray.md's table).
 #
 #   examples/povray/render-all.sh [OUT_DIR]     (default out/povray; build dqjulia first: build/bin/dqjulia)
 #

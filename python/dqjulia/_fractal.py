@@ -115,7 +115,7 @@ def _merge(base: dict, changes: Mapping) -> dict:
 
 
 class Fractal:
-    """A dual-quaternion Julia fractal: a parameter document (README, "Parameter file") and what
+    """A dual-quaternion Julia fractal: a parameter document (docs/parameter-file.md) and what
     is made from it: point evaluation, renders, OpenVDB bakes and meshes.
 
     The library validates every document and value; a rejected one raises ParameterError (a
@@ -153,7 +153,7 @@ class Fractal:
 
     @classmethod
     def from_file(cls, path: PathLike) -> Fractal:
-        """A fractal from a parameter file (JSON; README, "Parameter file")."""
+        """A fractal from a parameter file (JSON; docs/parameter-file.md)."""
         fractal = cls()
         fractal.load(path)
         return fractal
@@ -254,7 +254,7 @@ class Fractal:
     def evaluate(self, points: Any) -> numpy.ndarray:
         """Evaluates 8-D points (a then b, s i j k each): an array-like of shape (..., 8). Returns a
         structured array of shape (...) with the fields n (escape iteration, 0 = did not escape),
-        r (the escape norm at exit), ra and rb (|a| and |b| at exit) and de (distance estimate in
+        r (the escape norm at exit), ra and rb (the norms of a and b at exit) and de (distance estimate in
         8-D units). One call into the library for all points."""
         return self._evaluate(points, 8)
 
@@ -471,7 +471,7 @@ def has_feature(name: str) -> bool:
 
 def schema() -> dict[str, Any]:
     """The parameter schema: every key of the parameter document with its type, label, help,
-    default, range and choices (README, "Parameter schema")."""
+    default, range and choices (docs/parameter-file.md, "Parameter schema")."""
     with _native.Context() as context:
         return context.schema()
 

@@ -448,7 +448,7 @@ def _load() -> Tuple[ctypes.CDLL, Tuple[FrozenSet[str], FrozenSet[str]]]:
     except OSError as error:
         raise LibraryUnavailableError(
             "the dqjulia native library at %s could not be loaded (%s). It is self-contained and needs only "
-            "%s; on another system, build dqjulia there (README, Two commands)"
+            "%s; on another system, build dqjulia there (docs/developing.md, Two commands)"
             % (path, error, _REQUIREMENTS.get(sys.platform, _REQUIREMENTS["linux"]))
         ) from error
     try:

@@ -237,6 +237,7 @@ def check_package(args, checks):
         "dqjulia-%s-py3-none-manylinux_2_34_x86_64.whl" % version,
         "dqjulia-%s-py3-none-win_amd64.whl" % version,
         "dqjulia-%s.tar.gz" % version,
+        "dqjulia-%s-docs.zip" % version,
         "THIRD-PARTY.json",
         "SHA256SUMS",
     }

@@ -3,7 +3,7 @@
 // Code: core/src/bake/bake.cpp; the memory limits (MemoryLimitError, processMemoryHeadroom,
 // defaultMemoryLimit, formatBytes) in core/src/bake/memory.cpp.
 //
-// The surface (README "Baking"): with h the voxel size and eps = h / 4, the solid is the
+// The surface (docs/baking.md): with h the voxel size and eps = h / 4, the solid is the
 // N-iteration set together with every point whose 3-D distance estimate is below eps, cut to
 // the bake bounds. The bake samples f = DE/stretch - eps outside the set and -eps inside it
 // (zero on the surface, continuous where the DE goes to 0 at the set), meshes f = 0 and turns

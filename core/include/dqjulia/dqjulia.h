@@ -110,7 +110,7 @@ DQJ_API const char* dqj_context_error(dqj_context context);
  * bake or mesh found no surface ("the image shows no surface: " and why, or what to change). */
 DQJ_API const char* dqj_context_warning(dqj_context context);
 
-/* Parameters: the JSON document of the parameter file (see README), whole or in part;
+/* Parameters: the JSON document of the parameter file (docs/parameter-file.md), whole or in part;
  * missing keys take their defaults. */
 DQJ_API dqj_status dqj_context_load_params_file(dqj_context context, const char* path);
 DQJ_API dqj_status dqj_context_set_params_json(dqj_context context, const char* json);
@@ -120,7 +120,7 @@ DQJ_API dqj_status dqj_context_set_params_json(dqj_context context, const char* 
 DQJ_API dqj_status dqj_context_get_params_json(dqj_context context, char* buffer, size_t capacity, size_t* out_size);
 /* The parameter schema: JSON describing every key of the parameter document once: its type,
  * label, help text, default, range (min, max, and the soft range a slider offers) and choices
- * (README "Parameter schema"). Front ends build their controls from it, as the Blender add-on
+ * (docs/parameter-file.md, "Parameter schema"). Front ends build their controls from it, as the Blender add-on
  * does. Same buffer convention as dqj_context_get_params_json; it does not depend on the
  * context's parameters. */
 DQJ_API dqj_status dqj_params_schema_json(dqj_context context, char* buffer, size_t capacity, size_t* out_size);
@@ -169,7 +169,7 @@ DQJ_API dqj_status dqj_render_to_file(dqj_context context, const char* path, dqj
  * buffer convention as dqj_context_get_params_json. */
 DQJ_API dqj_status dqj_inspect_json(dqj_context context, char* buffer, size_t capacity, size_t* out_size);
 
-/* ---- Baking: OpenVDB volumes and meshes (README, "Baking") ----------------------------------
+/* ---- Baking: OpenVDB volumes and meshes (docs/baking.md) ----------------------------------
  * Bakes and meshes use the context's parameters at its current frame (dqj_context_set_frame)
  * and their "bake" section: resolution, bounds, band width, which grids, mesh adaptivity and
  * vertex colours. Set that section with dqj_context_set_params_json, or the resolution alone
@@ -242,7 +242,7 @@ typedef struct dqj_bake_stats {
     { .struct_size = sizeof(dqj_bake_stats) }
 DQJ_API dqj_status dqj_bake_get_stats(dqj_context context, dqj_bake_stats* out_stats);
 
-/* ---- Variations: the fractal next to the one in front of you (README "Exploring") ---------------
+/* ---- Variations: the fractal next to the one in front of you (docs/examples.md, "Exploring") ---------------
  * Variations of the context's parameters (at its frame, as a still: without "animation"): each
  * proven non-empty and not dust by the library's own analysis, neither a featureless ball nor
  * too small in the frame, no two nearly the same picture, all of them further from the original

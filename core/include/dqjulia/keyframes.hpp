@@ -1,5 +1,5 @@
 // dqjulia/keyframes.hpp - keyframed parameters: the parameter file's "animation" section
-// (README "Animation") and the parameters at a frame.
+// (docs/baking.md, "Animation") and the parameters at a frame.
 #pragma once
 
 #include <string>
@@ -11,7 +11,7 @@ namespace dqj {
 
 struct Params;
 
-/// Keyframes: the parameter file's "animation" section (README "Animation").
+/// Keyframes: the parameter file's "animation" section (docs/baking.md, "Animation").
 enum class Interpolation {
     Linear,  ///< straight line to the next key
     Smooth   ///< monotone cubic: smooth through the keys, never overshooting them

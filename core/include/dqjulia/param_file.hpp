@@ -3,7 +3,7 @@
 // (validate) and param_write.cpp (toJson, saveParams).
 //
 // One format for the CLI, the Blender add-on and the POV-Ray writer, described key by key by
-// the schema (schema.hpp, README "Parameter file"). Loading validates every value and throws
+// the schema (schema.hpp, docs/parameter-file.md). Loading validates every value and throws
 // ParamError naming the key, what was wrong and what is allowed.
 #pragma once
 

@@ -85,7 +85,7 @@ struct Box {
     glm::dvec3 max{1.0};
 };
 
-/// The grids a bake can write (bake.grids). README "Baking" says what each holds.
+/// The grids a bake can write (bake.grids). docs/baking.md says what each holds.
 enum class BakeGrid { Surface, Density, Color, Trap, Iterations };
 
 /// The "bake" section: OpenVDB volumes and meshes (bake.hpp, mesh.hpp).

@@ -35,7 +35,7 @@ enum class Type {
     Object,     ///< a section with fields "key.*"
     List,       ///< an array of objects with fields "key[].*"; min/max count them
     ColorList,  ///< an array of colours (the palette; the item is "key[]"); min/max count them
-    Animation   ///< keyframe tracks (README "Animation")
+    Animation   ///< keyframe tracks (docs/baking.md, "Animation")
 };
 
 enum Flags : std::uint32_t {
@@ -75,7 +75,7 @@ DQJ_API const Field* find(std::string_view key);
 DQJ_API const Field& field(std::string_view key);
 
 /// The schema document: {"format_version": 1, "fields": [{"key", "type", "label", "help",
-/// "default", "min", "max", ...}, ...]} (README "Parameter schema").
+/// "default", "min", "max", ...}, ...]} (docs/parameter-file.md, "Parameter schema").
 DQJ_API std::string schemaJson();
 
 /// The file's name of a choice field's value: choiceName("fractal.variant", 1) = "paper-coupled".

@@ -1,7 +1,7 @@
 // dqjulia/variations.hpp - variations of a parameter document: the fractal next to the one in
 // front of you, as fractal-flame editors' "Mutate" and Mandelbulber's "Randomizer" offer, but
 // each one proven non-empty, not dust, not a featureless ball, not too small in the frame, and
-// different enough from the original and from the others (README "Exploring").
+// different enough from the original and from the others (docs/examples.md, "Exploring").
 // Code: core/src/explore/variations.cpp.
 //
 // Candidates: every group that is not locked changes by an amount set by the strength (the
