@@ -11,9 +11,9 @@ scripts/install-deps.sh --windows  # what both builds need (after scripts/quicks
 # Meanwhile, the tests' packages (Blender, POV-Ray, Wine, Slurm, clang, ...: on a fresh machine a
 # few minutes of apt) and the Python venvs (about 800 MB of bpy wheels from PyPI, Sphinx for the
 # documentation's tests and, without a CPython 3.13, a Debian 13 root) are installed in the
-# background: network and disk more than CPU, beside the builds' compiling. The builds' configure steps look for all of them, so when
-# anything was new, both builds are configured again once it is there (seconds: nothing
-# recompiles).
+# background: network and disk more than CPU, beside the builds' compiling. The builds'
+# configure steps look for all of them, so when anything was new, both builds are configured
+# again once it is there (seconds: nothing recompiles).
 background_log="$(mktemp)"
 trap 'rm -f "$background_log"' EXIT
 (scripts/install-deps.sh && scripts/bpy-env.sh && scripts/tool-env.sh ruff && scripts/tool-env.sh mypy && scripts/tool-env.sh openjd && scripts/tool-env.sh twine && scripts/tool-env.sh auditwheel && scripts/tool-env.sh sphinx) >"$background_log" 2>&1 &
