@@ -14,6 +14,12 @@ docs_test.py examples    --cli DQJULIA --work DIR
     Command line, Baking and farms and POV-Ray pages runs with the built command and succeeds
 docs_test.py c-examples  --cc CC --include DIR... --lib LIBDIR --work DIR
     every ```c example of the C and C++ API page compiles (-Wall -Wextra -Werror) and runs
+docs_test.py extract-cpp --out DIR
+    writes every ```cpp example of the C and C++ API page to DIR/example_LINE.cpp (at configure
+    time; a file is rewritten only when its text changed), which CMake builds against
+    libdqjulia.a like the tests
+docs_test.py cpp-examples --program PROGRAM...
+    every such example, built, runs and succeeds, printing its results
 """
 
 import argparse
@@ -257,9 +263,36 @@ def c_examples(args):
     return report(checks)
 
 
+def extract_cpp(args):
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    wanted = {}
+    for line, source in fences(DOCS / "c-api.md", "cpp"):
+        wanted[out / ("example_%d.cpp" % line)] = source
+    for stale in set(out.glob("example_*.cpp")) - set(wanted):
+        stale.unlink()
+    for path, source in wanted.items():
+        if not path.exists() or path.read_text(encoding="utf-8") != source:
+            path.write_text(source, encoding="utf-8")
+    return 0
+
+
+def cpp_examples(args):
+    checks = {"the C and C++ API page has C++ examples, built": bool(args.program)}
+    for program in args.program:
+        name = Path(program).name
+        ran = subprocess.run([program], capture_output=True, text=True, check=False)
+        print(ran.stdout + ran.stderr)
+        checks["%s runs and succeeds" % name] = ran.returncode == 0
+        checks["%s printed its results" % name] = "rendered 64x48" in ran.stdout and "refused:" in ran.stdout
+    return report(checks)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("what", choices=("build", "references", "examples", "c-examples"))
+    parser.add_argument(
+        "what", choices=("build", "references", "examples", "c-examples", "extract-cpp", "cpp-examples")
+    )
     parser.add_argument("--sphinx")
     parser.add_argument("--cli")
     parser.add_argument("--out")
@@ -267,10 +300,18 @@ def main():
     parser.add_argument("--cc")
     parser.add_argument("--include", action="append", default=[])
     parser.add_argument("--lib")
+    parser.add_argument("--program", action="append", default=[])
     args = parser.parse_args()
     if args.what == "build" and not (args.sphinx and Path(args.sphinx).is_file()):
         skip_or_fail("Sphinx is not installed (scripts/tool-env.sh sphinx installs it)")
-    return {"build": build, "references": references, "examples": examples, "c-examples": c_examples}[args.what](args)
+    return {
+        "build": build,
+        "references": references,
+        "examples": examples,
+        "c-examples": c_examples,
+        "extract-cpp": extract_cpp,
+        "cpp-examples": cpp_examples,
+    }[args.what](args)
 
 
 if __name__ == "__main__":
