@@ -222,22 +222,23 @@ Mesh readPly(const std::string& path, bool colors) {
     return mesh;
 }
 
-/// A limit that lets about a third of the one-piece mesh's leaves be sampled at once.
-std::uint64_t aThirdOf(const BakeStats& whole) {
+/// A limit that lets about half of the one-piece mesh's leaves be sampled at once (a slab also
+/// samples 16 voxels on either side).
+std::uint64_t halfOf(const BakeStats& whole) {
     const std::uint64_t fixed = samplingEstimate(meshMemoryModel(), 0, false);
-    return fixed + (whole.estimatedBytes - fixed) / 3;
+    return fixed + (whole.estimatedBytes - fixed) / 2;
 }
 
 TEST_F(MeshStream, TheLimitChoosesTheSlabsAndTheFileHoldsTheMeshMadeInOnePiece) {
-    Params params = defaultAt(96);
+    Params params = defaultAt(128);
     BakeStats wholeStats;
     const Mesh whole = bakeMesh(params, {}, {}, &wholeStats);
     writeMesh(whole, path("whole.ply"));
     BakeOptions options;
-    options.memoryLimit = aThirdOf(wholeStats);
+    options.memoryLimit = halfOf(wholeStats);
     BakeStats stats;
     const MeshCounts counts = bakeMeshFile(params, path("m.ply"), options, {}, &stats);
-    EXPECT_GE(stats.slabs, 3u);
+    EXPECT_GE(stats.slabs, 2u);
     EXPECT_LE(stats.estimatedBytes, options.memoryLimit);
     EXPECT_EQ(counts.vertices, whole.positions.size());
     EXPECT_EQ(counts.quads, whole.quads.size());
@@ -315,7 +316,7 @@ TEST_F(MeshStream, AnAdaptiveMeshOverTheLimitIsRefusedWithTheReason) {
     bakeMesh(params, {}, {}, &wholeStats);
     params.bake.adaptivity = 0.3;
     BakeOptions options;
-    options.memoryLimit = aThirdOf(wholeStats);
+    options.memoryLimit = halfOf(wholeStats);
     try {
         bakeMeshFile(params, path("m.ply"), options);
         FAIL() << "not refused";
@@ -327,15 +328,15 @@ TEST_F(MeshStream, AnAdaptiveMeshOverTheLimitIsRefusedWithTheReason) {
 }
 
 TEST_F(MeshStream, ACancelAtAnySlabLeavesNothingAndKeepsTheFileThere) {
-    const Params params = defaultAt(96);
+    const Params params = defaultAt(128);
     BakeStats wholeStats;
     bakeMesh(params, {}, {}, &wholeStats);
     BakeOptions options;
-    options.memoryLimit = aThirdOf(wholeStats);
+    options.memoryLimit = halfOf(wholeStats);
     BakeStats stats;
     bakeMeshFile(params, path("count.ply"), options, {}, &stats);
     std::filesystem::remove(path("count.ply"));
-    ASSERT_GE(stats.slabs, 3u);
+    ASSERT_GE(stats.slabs, 2u);
     for (const std::string name : {"m.ply", "m.obj"}) {
         for (std::uint32_t slab = 1; slab <= stats.slabs; ++slab) {
             SCOPED_TRACE(name + ", slab " + std::to_string(slab));
