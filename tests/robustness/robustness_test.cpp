@@ -87,7 +87,7 @@ TEST_P(InterruptMesh, AtAnySlabLeavesNothingAndKeepsThePreviousMesh) {
     const fs::path output = dir_ / "mesh.ply";
     std::ofstream(output) << "previous mesh";
     const pid_t pid = dqj::test::spawnProgram(
-        DQJ_CLI, {"mesh", "-q", "--force", "-r", "384", "--max-memory", "120M", "-o", output.string()},
+        DQJ_CLI, {"mesh", "-q", "--force", "-r", "512", "--max-memory", "170M", "-o", output.string()},
         dir_ / "stderr.txt");
     ASSERT_GT(pid, 0);
     std::this_thread::sleep_for(std::chrono::milliseconds(GetParam()));
@@ -97,7 +97,7 @@ TEST_P(InterruptMesh, AtAnySlabLeavesNothingAndKeepsThePreviousMesh) {
     EXPECT_EQ(filesIn(dir_).size(), 2u);  // mesh.ply and stderr.txt only: no temporary, no faces set aside
 }
 
-INSTANTIATE_TEST_SUITE_P(Slabs, InterruptMesh, ::testing::Values(700, 2000, 4000),
+INSTANTIATE_TEST_SUITE_P(Slabs, InterruptMesh, ::testing::Values(500, 1500, 3000),
                          [](const auto& info) { return "after" + std::to_string(info.param) + "ms"; });
 
 TEST_F(Scratch, AFullDiskStopsAStreamedMeshAndLeavesNothing) {
@@ -105,9 +105,9 @@ TEST_F(Scratch, AFullDiskStopsAStreamedMeshAndLeavesNothing) {
     if (!tiny.mounted()) GTEST_SKIP() << "cannot mount a small tmpfs here (" << std::strerror(errno) << "); needs root";
     const fs::path& disk = tiny.path();
     std::ofstream(disk / "mesh.ply") << "previous mesh";
-    // Some 8 MB of PLY in slabs: the disk fills part of the way through.
+    // Some 6 MB of PLY in slabs: the disk fills part of the way through.
     const pid_t pid = dqj::test::spawnProgram(
-        DQJ_CLI, {"mesh", "-q", "--force", "-r", "192", "--max-memory", "100M", "-o", (disk / "mesh.ply").string()},
+        DQJ_CLI, {"mesh", "-q", "--force", "-r", "192", "--max-memory", "120M", "-o", (disk / "mesh.ply").string()},
         dir_ / "stderr.txt");
     ASSERT_GT(pid, 0);
     EXPECT_EQ(waitExit(pid), 1);
