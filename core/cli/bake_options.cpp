@@ -233,10 +233,10 @@ ProgressCallback bakeProgress(ProgressBar& bar, const BakeMonitor& monitor) {
     ProgressCallback draw = bar.callback();
     return [&bar, &monitor, draw](double fraction) {
         const std::uint32_t slabs = monitor.slabs.load();
-        bar.setStatus(std::string(bakeStageName(monitor.stage.load())) +
-                      (slabs > 1 ? " slab " + std::to_string(monitor.slab.load()) + " of " + std::to_string(slabs) : "") +
-                      ", " + shortCount(monitor.evaluated.load()) + " of " + shortCount(monitor.dense.load()) +
-                      " voxels evaluated");
+        bar.setStatus(
+            std::string(bakeStageName(monitor.stage.load())) +
+            (slabs > 1 ? " slab " + std::to_string(monitor.slab.load()) + " of " + std::to_string(slabs) : "") + ", " +
+            shortCount(monitor.evaluated.load()) + " of " + shortCount(monitor.dense.load()) + " voxels evaluated");
         return draw(fraction);
     };
 }

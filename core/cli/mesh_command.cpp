@@ -80,8 +80,8 @@ int runMesh(const BakeFlags& flags) {
         if (flags.stats) {
             if (frames.size() > 1) std::cout << "frame " << frames[index] << "\n";
             printBakeStats(stats);
-            std::cout << "slabs " << stats.slabs << "\nvertices " << mesh.vertices << "\nfaces " << faces
-                      << "\nquads " << mesh.quads << "\ntriangles " << mesh.triangles << "\ntriangulated "
+            std::cout << "slabs " << stats.slabs << "\nvertices " << mesh.vertices << "\nfaces " << faces << "\nquads "
+                      << mesh.quads << "\ntriangles " << mesh.triangles << "\ntriangulated "
                       << mesh.triangles + 2 * mesh.quads << "\n";
         }
     }

@@ -131,7 +131,8 @@ void expectSameMesh(const Mesh& streamed, const Mesh& whole, const std::string& 
     for (std::size_t index = 0; index < streamed.positions.size(); ++index) {
         const auto found = wholeIndex.find(bitsOf(streamed.positions[index]));
         ASSERT_NE(found, wholeIndex.end()) << what;
-        worstNormal = std::max(worstNormal, double(glm::length(streamed.normals[index] - whole.normals[found->second])));
+        worstNormal =
+            std::max(worstNormal, double(glm::length(streamed.normals[index] - whole.normals[found->second])));
         if (!whole.colors.empty())
             worstColour =
                 std::max(worstColour, double(glm::length(streamed.colors[index] - whole.colors[found->second])));

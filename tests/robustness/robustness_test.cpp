@@ -86,9 +86,10 @@ class InterruptMesh : public Scratch, public ::testing::WithParamInterface<int> 
 TEST_P(InterruptMesh, AtAnySlabLeavesNothingAndKeepsThePreviousMesh) {
     const fs::path output = dir_ / "mesh.ply";
     std::ofstream(output) << "previous mesh";
-    const pid_t pid = dqj::test::spawnProgram(
-        DQJ_CLI, {"mesh", "-q", "--force", "-r", "512", "--max-memory", "170M", "-o", output.string()},
-        dir_ / "stderr.txt");
+    const pid_t pid =
+        dqj::test::spawnProgram(DQJ_CLI,
+                                {"mesh", "-q", "--force", "-r", "512", "--max-memory", "170M", "-o", output.string()},
+                                dir_ / "stderr.txt");
     ASSERT_GT(pid, 0);
     std::this_thread::sleep_for(std::chrono::milliseconds(GetParam()));
     ASSERT_EQ(::kill(pid, SIGINT), 0);
@@ -106,9 +107,10 @@ TEST_F(Scratch, AFullDiskStopsAStreamedMeshAndLeavesNothing) {
     const fs::path& disk = tiny.path();
     std::ofstream(disk / "mesh.ply") << "previous mesh";
     // Some 6 MB of PLY in slabs: the disk fills part of the way through.
-    const pid_t pid = dqj::test::spawnProgram(
-        DQJ_CLI, {"mesh", "-q", "--force", "-r", "192", "--max-memory", "120M", "-o", (disk / "mesh.ply").string()},
-        dir_ / "stderr.txt");
+    const pid_t pid = dqj::test::spawnProgram(DQJ_CLI,
+                                              {"mesh", "-q", "--force", "-r", "192", "--max-memory", "120M", "-o",
+                                               (disk / "mesh.ply").string()},
+                                              dir_ / "stderr.txt");
     ASSERT_GT(pid, 0);
     EXPECT_EQ(waitExit(pid), 1);
     const std::string err = readFile(dir_ / "stderr.txt");

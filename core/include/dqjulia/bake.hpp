@@ -67,7 +67,7 @@ struct BakeStats {
     std::uint64_t interiorLeaves = 0;  ///< 8^3 blocks inside the set, never sampled (filled)
     std::uint64_t prunedLeaves = 0;    ///< sampled blocks then dropped: no surface cell touches them
     std::uint64_t activeVoxels = 0;    ///< active voxels of the surface level set (bakes; 0 for meshes)
-    std::uint64_t estimatedBytes = 0;  ///< the memory estimate checked against the limit (a mesh in slabs: the largest slab's)
+    std::uint64_t estimatedBytes = 0;  ///< the memory estimate checked against the limit (slabs: the largest's)
     std::uint64_t slabs = 0;           ///< meshes: the slabs it was made in (1: one piece); bakes: 0
     double voxelSize = 0.0;            ///< h, in slice units
     double seconds = 0.0;

@@ -48,7 +48,8 @@ MeshCounts bakeMeshFile(const Params& params, const std::string& path, const Bak
     validate(params);
     MeshFile file(path, params.bake.meshColors, options.existing);  // fails now, before the work
     BakeStats stats;
-    meshSurface(params, options, progress, [&file](Mesh&& part) { file.add(part); }, stats);
+    meshSurface(
+        params, options, progress, [&file](Mesh&& part) { file.add(part); }, stats);
     if (progress && !progress(1.0)) throw Cancelled();  // a signal in the last moments: publish nothing
     file.commit();
     if (statsOut) *statsOut = stats;

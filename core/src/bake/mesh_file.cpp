@@ -123,8 +123,9 @@ MeshFile::~MeshFile() = default;
 void MeshFile::add(const Mesh& part) {
     if (counts_.vertices + part.positions.size() > std::uint64_t(UINT32_MAX) + 1)
         throw std::runtime_error(AtomicFile::failureMessage(
-            file_.path(), "the mesh has more than 2^32 vertices, more than its 32-bit indices can name: lower the "
-                          "resolution or mesh a smaller region (bake.bounds)"));
+            file_.path(),
+            "the mesh has more than 2^32 vertices, more than its 32-bit indices can name: lower the "
+            "resolution or mesh a smaller region (bake.bounds)"));
     if (colors_ && part.colors.size() != part.positions.size())
         throw std::logic_error("MeshFile::add: a part without its colours");
     if (ply_) {

@@ -41,7 +41,6 @@ public:
     const MeshCounts& counts() const { return counts_; }
 
 private:
-
     bool ply_;
     bool colors_;
     AtomicFile file_;

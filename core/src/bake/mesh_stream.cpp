@@ -249,8 +249,7 @@ Mesh ownedPart(const Mesh& local, double lo, double hi, std::uint64_t firstVerte
     for (const auto& triangle : local.triangles)
         if (owned(triangle)) part.triangles.push_back({number(triangle[0]), number(triangle[1]), number(triangle[2])});
     for (const auto& quad : local.quads)
-        if (owned(quad))
-            part.quads.push_back({number(quad[0]), number(quad[1]), number(quad[2]), number(quad[3])});
+        if (owned(quad)) part.quads.push_back({number(quad[0]), number(quad[1]), number(quad[2]), number(quad[3])});
     Seam next;
     for (std::size_t vertex = 0; vertex < local.positions.size(); ++vertex)
         if (global[vertex] != kNoVertex && double(local.positions[vertex].x) >= hi)
@@ -368,9 +367,10 @@ void meshSurface(const Params& params, const BakeOptions& options, const Progres
             std::string message = error.what();
             if (message.rfind(prefix, 0) == 0) message.erase(0, prefix.size());
             if (params.bake.adaptivity > 0.0)
-                throw MemoryLimitError(message + " (a mesh with bake.adaptivity above 0 is made in one piece, since "
-                                                 "its merged cells cross slabs: with adaptivity 0 it would be "
-                                                 "meshed slab by slab)",
+                throw MemoryLimitError(message +
+                                           " (a mesh with bake.adaptivity above 0 is made in one piece, since "
+                                           "its merged cells cross slabs: with adaptivity 0 it would be "
+                                           "meshed slab by slab)",
                                        error.estimate(), error.limit());
             if (samplingEstimate(meshMemoryModel(), 0, options.dense) > error.limit()) throw;
         }
@@ -390,6 +390,14 @@ void meshSurface(const Params& params, const BakeOptions& options, const Progres
     } else {
         StagedProgress planning(within(0.0, 0.05), options.monitor);
         const SamplingLimit limit = samplingMemoryLimit(options);
+        const std::uint64_t planBytes =
+            samplingEstimate(meshMemoryModel(), 0, options.dense) + countLeafLayersBytes(params);
+        if (planBytes > limit.bytes)
+            throw MemoryLimitError("resolution " + std::to_string(params.bake.resolution) +
+                                       " does not fit the limit of " + limit.text() +
+                                       " even meshed slab by slab: planning the slabs alone may take " +
+                                       formatBytes(planBytes) + limit.advice(),
+                                   planBytes, limit.bytes);
         // A layer too large even alone is refused as soon as its chunk is counted.
         const std::size_t halo = kSlabHalo / kLayer;
         layers = countLeafLayers(params, options, planning.stage(BakeStage::Classifying, 0.0, 1.0),
@@ -421,8 +429,7 @@ void meshSurface(const Params& params, const BakeOptions& options, const Progres
         // The slab's bounds, in voxels and in slice units (open outwards at the ends).
         const int x0 = (layers.first + int(slab.first)) * kLayer, x1 = (layers.first + int(slab.end)) * kLayer;
         const double lo = slab.first == 0 ? -std::numeric_limits<double>::infinity() : x0 * voxel;
-        const double hi =
-            slab.end == layers.sampled.size() ? std::numeric_limits<double>::infinity() : x1 * voxel;
+        const double hi = slab.end == layers.sampled.size() ? std::numeric_limits<double>::infinity() : x1 * voxel;
         const openvdb::CoordBBox window(openvdb::Coord(x0 - kSlabHalo, full.min().y(), full.min().z()),
                                         openvdb::Coord(x1 + kSlabHalo - 1, full.max().y(), full.max().z()));
         SampledSurface sampled = sampleSurface(params, options, meshMemoryModel(), staged, 0.05, 0.8, &window);
@@ -433,8 +440,9 @@ void meshSurface(const Params& params, const BakeOptions& options, const Progres
         if (params.bake.meshColors) addColours(params, voxel, part, staged.stage(BakeStage::Meshing, 0.9, 1.0), stats);
         vertices += part.positions.size();
         if (vertices > std::uint64_t(UINT32_MAX))
-            throw std::runtime_error("the mesh has more than 2^32 vertices, more than its 32-bit indices can name: "
-                                     "lower the resolution or mesh a smaller region (bake.bounds)");
+            throw std::runtime_error(
+                "the mesh has more than 2^32 vertices, more than its 32-bit indices can name: "
+                "lower the resolution or mesh a smaller region (bake.bounds)");
         sink(std::move(part));
         platform::releaseFreedMemory();
     }

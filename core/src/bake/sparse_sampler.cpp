@@ -169,7 +169,8 @@ public:
         for (auto it = states_.cbeginValueOn(); it; ++it) {
             if (*it != kDeferred) continue;
             const Coord key = it.getCoord();
-            if (const std::ptrdiff_t layer = layerOf(Coord(key.x() * kLeafSize, key.y() * kLeafSize, key.z() * kLeafSize));
+            if (const std::ptrdiff_t layer =
+                    layerOf(Coord(key.x() * kLeafSize, key.y() * kLeafSize, key.z() * kLeafSize));
                 layer >= 0)
                 ++layers.deferred[std::size_t(layer)];
         }
@@ -283,20 +284,18 @@ private:
         const int z0 = floorTo(lo.z(), kTopBlockSize);
         std::vector<Lists> lists(blocks[0] * blocks[1]);
         std::atomic<std::uint64_t> surfaceLeaves{0};
-        parallelForWithProgress(lists.size(), progress,
-                                [&](std::size_t column, const std::atomic<bool>& stop) {
-                                    const int x = x0 + int(column / blocks[1]) * kTopBlockSize;
-                                    const int y = y0 + int(column % blocks[1]) * kTopBlockSize;
-                                    std::uint64_t count = 0;
-                                    for (std::uint64_t k = 0; k < blocks[2] && !stop; ++k)
-                                        classifyBlock(Coord(x, y, z0 + int(k) * kTopBlockSize), kTopBlockSize,
-                                                      lists[column], count);
-                                    evaluated_ += count;
-                                    progress_.countEvaluations(count);
-                                    // Refuse early: the surface leaves alone already exceed the limit.
-                                    const std::uint64_t total = surfaceLeaves += lists[column].surface.size();
-                                    if (estimateFor(total) > limit_.bytes) checkMemory(total, false);
-                                });
+        parallelForWithProgress(lists.size(), progress, [&](std::size_t column, const std::atomic<bool>& stop) {
+            const int x = x0 + int(column / blocks[1]) * kTopBlockSize;
+            const int y = y0 + int(column % blocks[1]) * kTopBlockSize;
+            std::uint64_t count = 0;
+            for (std::uint64_t k = 0; k < blocks[2] && !stop; ++k)
+                classifyBlock(Coord(x, y, z0 + int(k) * kTopBlockSize), kTopBlockSize, lists[column], count);
+            evaluated_ += count;
+            progress_.countEvaluations(count);
+            // Refuse early: the surface leaves alone already exceed the limit.
+            const std::uint64_t total = surfaceLeaves += lists[column].surface.size();
+            if (estimateFor(total) > limit_.bytes) checkMemory(total, false);
+        });
         std::vector<Coord> wave;
         std::vector<Coord> deferred;
         for (const Lists& list : lists) {
@@ -401,18 +400,17 @@ private:
         if (estimate <= limit_.bytes) return;
         const std::string limit = limit_.text();
         const std::string blocks = std::to_string(leaves) + " blocks of 8^3 voxels to sample";
-        throw MemoryLimitError(
-            "resolution " + std::to_string(params_.bake.resolution) +
-                (final ? " needs an estimated " + formatBytes(estimate) + " (" + blocks + "), more than the limit of " +
-                             limit
-                 : leaves > 0 ? " needs more than the limit of " + limit + ": the first " + blocks + " already need " +
-                                    formatBytes(estimate)
-                              : " needs at least " + formatBytes(estimate) +
-                                    " before any voxel is sampled, more than "
-                                    "the limit of " +
-                                    limit) +
-                limit_.advice(),
-            estimate, limit_.bytes);
+        throw MemoryLimitError("resolution " + std::to_string(params_.bake.resolution) +
+                                   (final ? " needs an estimated " + formatBytes(estimate) + " (" + blocks +
+                                                "), more than the limit of " + limit
+                                    : leaves > 0 ? " needs more than the limit of " + limit + ": the first " + blocks +
+                                                       " already need " + formatBytes(estimate)
+                                                 : " needs at least " + formatBytes(estimate) +
+                                                       " before any voxel is sampled, more than "
+                                                       "the limit of " +
+                                                       limit) +
+                                   limit_.advice(),
+                               estimate, limit_.bytes);
     }
 
     const Params& params_;
@@ -590,8 +588,8 @@ SamplingLimit samplingMemoryLimit(const BakeOptions& options) {
     SamplingLimit limit;
     limit.bytes = std::min(requested, processLimit);
     limit.processLimited = processLimit <= requested;  // defaultMemoryLimit() too may be the process limit
-    limit.source = limit.processLimited ? " (what this process may still allocate under its memory limits: ulimit -v, "
-                                          "ulimit -d or its cgroup's memory.max)"
+    limit.source = limit.processLimited  ? " (what this process may still allocate under its memory limits: ulimit -v, "
+                                           "ulimit -d or its cgroup's memory.max)"
                    : options.memoryLimit ? ""
                                          : " (half of the available memory)";
     return limit;
@@ -603,6 +601,17 @@ std::string SamplingLimit::advice() const {
     return processLimited
                ? "; lower the resolution, bake a smaller region (bake.bounds) or raise the process's limit"
                : "; lower the resolution, bake a smaller region (bake.bounds) or raise the limit (--max-memory)";
+}
+
+std::uint64_t countLeafLayersBytes(const Params& params) {
+    // A chunk's classification keeps a state per leaf in an Int32Tree keyed by leaf: its window,
+    // 8 + 2 leaves across x, touches up to 3 of the tree's leaf nodes (8^3 keys each) across x,
+    // and at worst every node across y and z.
+    const CoordBBox full = bakeIndexBox(params);
+    using StateLeaf = openvdb::Int32Tree::LeafNodeType;
+    const std::uint64_t nodesY = std::uint64_t(full.dim().y() / (kLeafSize * 8) + 2);
+    const std::uint64_t nodesZ = std::uint64_t(full.dim().z() / (kLeafSize * 8) + 2);
+    return 3 * nodesY * nodesZ * (sizeof(StateLeaf) + 64);
 }
 
 LeafLayers countLeafLayers(const Params& params, const BakeOptions& options, const ProgressCallback& progress,
@@ -646,9 +655,8 @@ LeafLayers countLeafLayers(const Params& params, const BakeOptions& options, con
         Sampler sampler(params, quiet, MemoryModel{}, staged, &window);
         const double begin = double(step) / double(chunks), end = double(step + 1) / double(chunks);
         sampler.countLayers(layers, box,
-                            progress ? ProgressCallback([&](double fraction) {
-                                return progress(begin + fraction * (end - begin));
-                            })
+                            progress ? ProgressCallback(
+                                           [&](double fraction) { return progress(begin + fraction * (end - begin)); })
                                      : ProgressCallback());
         if (counted) counted(layers, chunk * kChunkLayers, std::min(count, (chunk + 1) * kChunkLayers));
     }

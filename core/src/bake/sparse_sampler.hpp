@@ -145,6 +145,9 @@ struct LeafLayers {
     std::uint64_t evaluated = 0;          ///< fractal evaluations the classification took
 };
 
+/// The most memory countLeafLayers may hold at once (a chunk's leaf states at worst).
+std::uint64_t countLeafLayersBytes(const Params& params);
+
 /// Called as each chunk of layers [first, end) has been counted (the others may still be 0).
 using LayersCounted = std::function<void(const LeafLayers& layers, std::size_t first, std::size_t end)>;
 
