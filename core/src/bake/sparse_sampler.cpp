@@ -32,6 +32,7 @@ namespace {
 
 constexpr int kLeafSize = int(FloatLeaf::DIM);                // 8
 constexpr int kTopBlockSize = 64;                             // classification starts with blocks this big
+constexpr std::size_t kChunkLayers = kTopBlockSize / kLeafSize;  // countLeafLayers: the leaf layers of a chunk
 constexpr double kFloatLeafBytes = sizeof(FloatLeaf) + 64.0;  // a leaf and its share of the tree
 
 /// A leaf's state during sampling, stored per leaf (key = origin / 8).
@@ -296,9 +297,18 @@ private:
             const std::uint64_t total = surfaceLeaves += lists[column].surface.size();
             if (estimateFor(total) > limit_.bytes) checkMemory(total, false);
         });
+        // Into two lists of their exact size, each column's freed as it is taken: all the lists
+        // together never hold more than four Coords a leaf (countLeafLayersBytes counts on it).
+        std::size_t surfaceCount = 0, deferredCount = 0;
+        for (const Lists& list : lists) {
+            surfaceCount += list.surface.size();
+            deferredCount += list.deferred.size();
+        }
         std::vector<Coord> wave;
         std::vector<Coord> deferred;
-        for (const Lists& list : lists) {
+        wave.reserve(surfaceCount + deferredCount);  // the deferred leaves next to skipped space join it
+        deferred.reserve(deferredCount);
+        for (Lists& list : lists) {
             for (const Coord& origin : list.surface) {
                 states_.setValue(leafKey(origin), kSurface);
                 wave.push_back(origin);
@@ -307,6 +317,7 @@ private:
                 states_.setValue(leafKey(origin), kDeferred);
                 deferred.push_back(origin);
             }
+            list = Lists{};
         }
         // A deferred leaf next to skipped space touches outside values there: sample it.
         const std::vector<Coord> offsets = neighbourOffsets();
@@ -604,14 +615,31 @@ std::string SamplingLimit::advice() const {
 }
 
 std::uint64_t countLeafLayersBytes(const Params& params) {
-    // A chunk's classification keeps a state per leaf in an Int32Tree keyed by leaf: its window,
-    // 8 + 2 leaves across x, touches up to 3 of the tree's leaf nodes (8^3 keys each) across x,
-    // and at worst every node across y and z.
+    // A bound from the resolution alone. A chunk's classification, at worst (no leaf of its window
+    // proven empty), holds for each leaf of its window (the chunk's layers and one more on either
+    // side): a Coord in its column's list (up to twice that while the list grows), then in the wave
+    // and the deferred leaves (classify), four Coords a leaf at most; and a state in an Int32Tree
+    // keyed by leaf, whose leaf nodes (each with its 8^3 values, allocated apart from the node) the
+    // window touches up to 3 across x (10 keys) and all across y and z, with the internal nodes
+    // above them. At 16384 this is 2.5 GB (8192: 630 MB, 4096: 160 MB); measured there (default
+    // fractal, the middle chunk): 400 MB. (Counting sizeof(leaf node) alone, without its values,
+    // once gave 30 MB, and a 600 MB cap ran out here instead of refusing.)
     const CoordBBox full = bakeIndexBox(params);
-    using StateLeaf = openvdb::Int32Tree::LeafNodeType;
-    const std::uint64_t nodesY = std::uint64_t(full.dim().y() / (kLeafSize * 8) + 2);
-    const std::uint64_t nodesZ = std::uint64_t(full.dim().z() / (kLeafSize * 8) + 2);
-    return 3 * nodesY * nodesZ * (sizeof(StateLeaf) + 64);
+    using StateTree = openvdb::Int32Tree;
+    using StateLeaf = StateTree::LeafNodeType;
+    using Lower = StateTree::RootNodeType::ChildNodeType::ChildNodeType;  // 16^3 leaf nodes
+    using Upper = StateTree::RootNodeType::ChildNodeType;                 // 32^3 lower nodes
+    constexpr std::uint64_t kAllocation = 64;                             // malloc's own, a block
+    auto across = [](std::uint64_t keys, std::uint64_t perNode) { return keys / perNode + 2; };
+    const std::uint64_t keysX = kChunkLayers + 2;
+    const std::uint64_t keysY = std::uint64_t(full.dim().y() / kLeafSize + 2);
+    const std::uint64_t keysZ = std::uint64_t(full.dim().z() / kLeafSize + 2);
+    const std::uint64_t lists = 4 * sizeof(Coord) * keysX * keysY * keysZ;
+    const std::uint64_t leafNodes = 3 * across(keysY, StateLeaf::DIM) * across(keysZ, StateLeaf::DIM);
+    const std::uint64_t lowerNodes = 2 * across(keysY, Lower::DIM) * across(keysZ, Lower::DIM);
+    const std::uint64_t upperNodes = 2 * across(keysY, Upper::DIM) * across(keysZ, Upper::DIM);
+    return lists + leafNodes * (sizeof(StateLeaf) + StateLeaf::SIZE * sizeof(std::int32_t) + 2 * kAllocation) +
+           lowerNodes * (sizeof(Lower) + kAllocation) + upperNodes * (sizeof(Upper) + kAllocation);
 }
 
 LeafLayers countLeafLayers(const Params& params, const BakeOptions& options, const ProgressCallback& progress,
@@ -634,7 +662,6 @@ LeafLayers countLeafLayers(const Params& params, const BakeOptions& options, con
     // leaves see their true neighbours (the first wave takes those next to skipped space).
     // From the middle outwards, where a solid is usually widest: a caller that refuses a layer
     // too large for its limit does so after the first few chunks.
-    constexpr std::size_t kChunkLayers = kTopBlockSize / kLeafSize;
     const std::size_t chunks = (count + kChunkLayers - 1) / kChunkLayers;
     std::vector<std::size_t> order(chunks);
     for (std::size_t chunk = 0; chunk < chunks; ++chunk) order[chunk] = chunk;
