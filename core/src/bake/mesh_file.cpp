@@ -29,7 +29,7 @@ std::string headerText(bool ply, bool colors, std::uint64_t vertices, std::uint6
     } else {
         first = "# dqjulia " + std::string(DQJ_VERSION_STRING) + ": " + std::to_string(vertices) + " vertices, " +
                 std::to_string(faces) + " faces" + (colors ? "; vertex colours (sRGB) after x y z" : "");
-        rest = "\n";
+        rest.push_back('\n');  // not rest = "\n": GCC 12 warns falsely (-Wrestrict) on that
     }
     const std::size_t size = first.size() + rest.size();
     if (room > size) first.append(room - size, ' ');
