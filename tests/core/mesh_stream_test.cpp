@@ -78,6 +78,7 @@ std::vector<std::vector<Bits>> facesByPosition(const Mesh& mesh) {
     std::vector<std::vector<Bits>> faces;
     auto add = [&](const auto& face) {
         std::vector<Bits> corners;
+        corners.reserve(face.size());
         for (const std::uint32_t index : face) corners.push_back(bitsOf(mesh.positions[index]));
         std::rotate(corners.begin(), std::min_element(corners.begin(), corners.end()), corners.end());
         faces.push_back(std::move(corners));

@@ -385,7 +385,7 @@ void meshSurface(const Params& params, const BakeOptions& options, const Progres
         const openvdb::CoordBBox full = bakeIndexBox(params);
         layers.first = int(std::floor(double(full.min().x()) / kLayer));
         const int lastLayer = int(std::floor(double(full.max().x()) / kLayer));
-        layers.sampled.assign(std::size_t(lastLayer - layers.first + 1), 0);
+        layers.sampled.assign(std::size_t(lastLayer - layers.first) + 1, 0);
         slabs = evenSlabs(layers, slabVoxels);
     } else {
         StagedProgress planning(within(0.0, 0.05), options.monitor);

@@ -648,7 +648,7 @@ LeafLayers countLeafLayers(const Params& params, const BakeOptions& options, con
     LeafLayers layers;
     const int firstX = int(std::floor(double(full.min().x()) / kLeafSize)) * kLeafSize;
     layers.first = firstX / kLeafSize;
-    const std::size_t count = std::size_t((full.max().x() - firstX) / kLeafSize + 1);
+    const std::size_t count = std::size_t(full.max().x() - firstX) / kLeafSize + 1;
     layers.sampled.assign(count, 0);
     layers.deferred.assign(count, 0);
     if (options.dense) {  // every leaf is sampled, nothing is classified

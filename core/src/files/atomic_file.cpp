@@ -377,7 +377,8 @@ struct ScratchFile::State {
 
 ScratchFile::ScratchFile(const std::string& path) : path_(path), state_(std::make_unique<State>()) {
     State& state = *state_;
-    state.fd = reported(path_, [&] { return platform::openScratchFile(folderOf(path_), platform::hiddenPrefix(path_)); });
+    const std::string folder = folderOf(path_), prefix = platform::hiddenPrefix(path_);
+    state.fd = reported(path_, [&] { return platform::openScratchFile(folder, prefix); });
     state.buffer = std::make_unique<CheckedBuffer>(state.fd);
     state.stream = std::make_unique<std::ostream>(state.buffer.get());
 }
