@@ -90,7 +90,12 @@ void BakeFlags::addTo(CLI::App& command, BakeCommand kind) {
     if (kind == BakeCommand::Bake)
         command.add_option("--tile", tile, "With --tiles: bake tile K alone (default: every tile, one after another)");
     command.add_option("--max-memory", maxMemory,
-                       "Refuse when the estimate exceeds this, e.g. 4G or 512M (default: half the available memory)");
+                       kind == BakeCommand::Mesh
+                           ? "Mesh in slabs, each written as it is made, when the estimate in one piece exceeds this, "
+                             "and refuse when even the thinnest slab does; e.g. 4G or 512M (default: half the "
+                             "available memory)"
+                           : "Refuse when the estimate exceeds this, e.g. 4G or 512M (default: half the available "
+                             "memory)");
     command
         .add_option("--threads", threads,
                     "Threads to use (default: SLURM_CPUS_PER_TASK, else the CPUs this process may run on)")
@@ -227,8 +232,11 @@ std::string framePath(const std::string& path, int frame) {
 ProgressCallback bakeProgress(ProgressBar& bar, const BakeMonitor& monitor) {
     ProgressCallback draw = bar.callback();
     return [&bar, &monitor, draw](double fraction) {
-        bar.setStatus(std::string(bakeStageName(monitor.stage.load())) + ", " + shortCount(monitor.evaluated.load()) +
-                      " of " + shortCount(monitor.dense.load()) + " voxels evaluated");
+        const std::uint32_t slabs = monitor.slabs.load();
+        bar.setStatus(
+            std::string(bakeStageName(monitor.stage.load())) +
+            (slabs > 1 ? " slab " + std::to_string(monitor.slab.load()) + " of " + std::to_string(slabs) : "") + ", " +
+            shortCount(monitor.evaluated.load()) + " of " + shortCount(monitor.dense.load()) + " voxels evaluated");
         return draw(fraction);
     };
 }

@@ -47,13 +47,16 @@ int runMesh(const BakeFlags& flags) {
         options.dense = flags.dense;
         options.memoryLimit = memoryLimit;
         options.monitor = &monitor;
+        options.existing = existingPolicy(flags.force);
         BakeStats stats;
-        Mesh mesh;
+        MeshCounts mesh;
         {
             ProgressBar bar(frames.size() > 1 ? "meshing frame " + std::to_string(frames[index]) : "meshing",
                             flags.quiet);
             try {
-                mesh = bakeMesh(perFrame[index], options, bakeProgress(bar, monitor), &stats);
+                // Written as it is made, slab by slab where the memory limit asks for it; the file
+                // appears only complete (a signal in the last moments, too, leaves nothing).
+                mesh = bakeMeshFile(perFrame[index], paths[index], options, bakeProgress(bar, monitor), &stats);
             } catch (const Cancelled&) {
                 bar.finish();
                 if (index == 0) throw;
@@ -63,26 +66,23 @@ int runMesh(const BakeFlags& flags) {
             }
             bar.finish();
         }
-        if (interrupted()) {  // a signal during the last moments of the work: write nothing
-            std::cerr << "dqjulia mesh: interrupted; " << paths[index] << " was not written\n";
-            return kInterrupted;
-        }
-        writeMesh(mesh, paths[index], existingPolicy(flags.force));
-        if (mesh.positions.empty())
+        const std::uint64_t faces = mesh.quads + mesh.triangles;
+        if (mesh.vertices == 0)
             std::cerr << "dqjulia mesh: warning: "
                       << emptyResultMessage(EmptyResult::Mesh, inspect(perFrame[index]).emptyReason, paths[index])
                       << "\n";
         if (!flags.quiet)
-            std::cerr << "wrote " << paths[index] << " (" << mesh.positions.size() << " vertices, "
-                      << mesh.quads.size() + mesh.triangles.size() << " faces; " << evaluatedSummary(stats) << "; "
-                      << std::fixed << std::setprecision(2) << stats.seconds << " s)\n"
+            std::cerr << "wrote " << paths[index] << " (" << mesh.vertices << " vertices, " << faces << " faces"
+                      << (stats.slabs > 1 ? ", meshed in " + std::to_string(stats.slabs) + " slabs" : "") << "; "
+                      << evaluatedSummary(stats) << "; " << std::fixed << std::setprecision(2) << stats.seconds
+                      << " s)\n"
                       << std::defaultfloat;
         if (flags.stats) {
             if (frames.size() > 1) std::cout << "frame " << frames[index] << "\n";
             printBakeStats(stats);
-            std::cout << "vertices " << mesh.positions.size() << "\nfaces " << mesh.quads.size() + mesh.triangles.size()
-                      << "\nquads " << mesh.quads.size() << "\ntriangles " << mesh.triangles.size() << "\ntriangulated "
-                      << mesh.triangleCount() << "\n";
+            std::cout << "slabs " << stats.slabs << "\nvertices " << mesh.vertices << "\nfaces " << faces << "\nquads "
+                      << mesh.quads << "\ntriangles " << mesh.triangles << "\ntriangulated "
+                      << mesh.triangles + 2 * mesh.quads << "\n";
         }
     }
     return kSuccess;

@@ -41,6 +41,8 @@ struct BakeMonitor {
     std::atomic<BakeStage> stage{BakeStage::Classifying};
     std::atomic<std::uint64_t> evaluated{0};  ///< fractal evaluations so far
     std::atomic<std::uint64_t> dense{0};      ///< voxels a dense bake evaluates (set at the start)
+    std::atomic<std::uint32_t> slab{0};       ///< a mesh made in slabs: the slab being made (from 1)
+    std::atomic<std::uint32_t> slabs{0};      ///< and how many there are (0 or 1: one piece)
 };
 
 /// One tile of a tiled bake (tiles.hpp): the whole bake's index box cut into
@@ -65,7 +67,8 @@ struct BakeStats {
     std::uint64_t interiorLeaves = 0;  ///< 8^3 blocks inside the set, never sampled (filled)
     std::uint64_t prunedLeaves = 0;    ///< sampled blocks then dropped: no surface cell touches them
     std::uint64_t activeVoxels = 0;    ///< active voxels of the surface level set (bakes; 0 for meshes)
-    std::uint64_t estimatedBytes = 0;  ///< the memory estimate checked against the limit
+    std::uint64_t estimatedBytes = 0;  ///< the memory estimate checked against the limit (slabs: the largest's)
+    std::uint64_t slabs = 0;           ///< meshes: the slabs it was made in (1: one piece); bakes: 0
     double voxelSize = 0.0;            ///< h, in slice units
     double seconds = 0.0;
 };

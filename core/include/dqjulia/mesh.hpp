@@ -8,6 +8,12 @@
 // colours are the material's colouring of the orbit at each vertex (as the renderer shades it).
 // Cost: the bake's sparse sampling, a volumeToMesh, and one fractal evaluation per vertex for
 // colours; no level set is built.
+//
+// Where the surface's sampling and meshing would exceed the memory limit (BakeOptions), the
+// surface is meshed in slabs across x, each as thick as the limit allows (mesh_stream.hpp in the
+// core): the same mesh, geometry and connectivity (at adaptivity 0; with adaptivity > 0 a mesh is
+// made in one piece), with vertices in another order. bakeMeshFile writes each slab out as it
+// comes, so its memory is bounded by a slab; bakeMesh holds the whole mesh.
 #pragma once
 
 #include <array>
@@ -37,10 +43,25 @@ struct Mesh {
     DQJ_API std::vector<std::uint32_t> triangulated() const;
 };
 
+/// What a mesh file holds.
+struct MeshCounts {
+    std::uint64_t vertices = 0;
+    std::uint64_t quads = 0;
+    std::uint64_t triangles = 0;
+};
+
 /// Meshes `params` (validated; see bakeVdb for frames). Throws like bakeVdb. `stats` (optional)
 /// receives the bake's counters.
 DQJ_API Mesh bakeMesh(const Params& params, const BakeOptions& options = {}, const ProgressCallback& progress = {},
                       BakeStats* stats = nullptr);
+
+/// Meshes `params` into the file `path` (as writeMesh writes it), slab by slab where the memory
+/// limit asks for it, each slab written as it is made: the file appears complete or not at all
+/// (options.existing decides whether it may replace one). Throws like bakeMesh and writeMesh;
+/// Cancelled (the callback returned false, at any slab, or at 1.0 just before the file is published)
+/// leaves no file behind.
+DQJ_API MeshCounts bakeMeshFile(const Params& params, const std::string& path, const BakeOptions& options = {},
+                                const ProgressCallback& progress = {}, BakeStats* stats = nullptr);
 
 /// Writes `.ply` (binary little-endian: float positions and normals, 8-bit sRGB colours,
 /// quads and triangles) or `.obj` (text: `v x y z [r g b]`, `vn`, `f a//a ...`), by the path's

@@ -32,6 +32,7 @@ namespace {
 
 constexpr int kLeafSize = int(FloatLeaf::DIM);                // 8
 constexpr int kTopBlockSize = 64;                             // classification starts with blocks this big
+constexpr std::size_t kChunkLayers = kTopBlockSize / kLeafSize;  // countLeafLayers: the leaf layers of a chunk
 constexpr double kFloatLeafBytes = sizeof(FloatLeaf) + 64.0;  // a leaf and its share of the tree
 
 /// A leaf's state during sampling, stored per leaf (key = origin / 8).
@@ -129,16 +130,16 @@ double largestStretch(Slice slice, bool keepReal, bool keepDual) {
 /// Classification and sampling for one bake.
 class Sampler {
 public:
-    Sampler(const Params& params, const BakeOptions& options, const MemoryModel& memory, StagedProgress& progress)
+    Sampler(const Params& params, const BakeOptions& options, const MemoryModel& memory, StagedProgress& progress,
+            const CoordBBox* window = nullptr)
         : params_(params),
           options_(options),
           memory_(memory),
           progress_(progress),
           f_(params, bakeVoxelSize(params)),
-          h_(f_.voxelSize()) {
-        const Box& box = f_.region().box();
-        for (int axis = 0; axis < 3; ++axis)
-            dense_ *= std::uint64_t(std::max<long long>(1, std::llround((box.max[axis] - box.min[axis]) / h_)));
+          h_(f_.voxelSize()),
+          dense_(denseVoxels(params)),
+          slab_(window != nullptr) {
         indexBox_ = bakeIndexBox(params);
         if (options.tile) {
             // A tile samples the whole bake's grid in its window only; blocks and leaves stay
@@ -147,27 +148,45 @@ public:
             indexBox_.intersect(tileWindow(params, *options.tile));
             dense_ = std::max<std::uint64_t>(1, std::uint64_t(double(dense_) * double(indexBox_.volume()) / whole));
         }
-        // An explicit limit too is capped by what the process may really allocate (ulimit -v,
-        // cgroups): beyond that the bake would fail late with an allocation error.
-        const std::uint64_t processLimit = processMemoryHeadroom();
-        const std::uint64_t requested = options.memoryLimit ? options.memoryLimit : defaultMemoryLimit();
-        limit_ = std::min(requested, processLimit);
-        processLimited_ = processLimit <= requested;  // defaultMemoryLimit() too may be the process limit
-        limitSource_ = processLimited_ ? " (what this process may still allocate under its memory limits: ulimit -v, "
-                                         "ulimit -d or its cgroup's memory.max)"
-                       : options.memoryLimit ? ""
-                                             : " (half of the available memory)";
+        if (window) {  // a slab of a streamed mesh: likewise, the whole bake's grid in the window only
+            const double whole = double(indexBox_.volume());
+            indexBox_.intersect(*window);
+            dense_ = std::max<std::uint64_t>(1, std::uint64_t(double(dense_) * double(indexBox_.volume()) / whole));
+        }
+        limit_ = samplingMemoryLimit(options);
+    }
+
+    /// Classification alone (no memory check, nothing sampled): the first wave's leaves and the
+    /// deferred leaves, each by leaf layer along x, for the layers of `counted`.
+    void countLayers(LeafLayers& layers, const CoordBBox& counted, const ProgressCallback& progress) {
+        limit_.bytes = UINT64_MAX;
+        const std::vector<Coord> wave = classify(progress);
+        auto layerOf = [&](const Coord& origin) -> std::ptrdiff_t {
+            if (origin.x() < counted.min().x() || origin.x() > counted.max().x()) return -1;
+            return std::ptrdiff_t(floorTo(origin.x(), kLeafSize) / kLeafSize - layers.first);
+        };
+        for (const Coord& origin : wave)
+            if (const std::ptrdiff_t layer = layerOf(origin); layer >= 0) ++layers.sampled[std::size_t(layer)];
+        for (auto it = states_.cbeginValueOn(); it; ++it) {
+            if (*it != kDeferred) continue;
+            const Coord key = it.getCoord();
+            if (const std::ptrdiff_t layer =
+                    layerOf(Coord(key.x() * kLeafSize, key.y() * kLeafSize, key.z() * kLeafSize));
+                layer >= 0)
+                ++layers.deferred[std::size_t(layer)];
+        }
+        layers.evaluated += evaluated_.load();
     }
 
     SampledSurface run(double split, double end) {
-        progress_.setDense(dense_);
+        if (!slab_) progress_.setDense(dense_);  // a slab's mesh sets the whole's
         std::vector<Coord> wave;
         if (options_.dense) {
             checkMemory(leafCount(), true);  // before the list of them is made
             wave = allLeaves();              // nothing to classify: every leaf is sampled
         } else {
             checkMemory(0, false);  // the fixed part alone may exceed a small limit
-            wave = classify(split);
+            wave = classify(progress_.stage(BakeStage::Classifying, 0.0, split));
         }
 
         openvdb::FloatTree::Ptr tree(new openvdb::FloatTree(f_.background()));
@@ -259,30 +278,37 @@ private:
     /// the resolution, a list per column (3 MB at 16384), never with its cube (a list per block
     /// took 1 GB there before any check could refuse). The leaves come out in x, y, z order of
     /// their blocks, as from a list of blocks.
-    std::vector<Coord> classify(double split) {
+    std::vector<Coord> classify(const ProgressCallback& progress) {
         const Coord lo = indexBox_.min();
         const std::array<std::uint64_t, 3> blocks = blocksAlong(kTopBlockSize);
         const int x0 = floorTo(lo.x(), kTopBlockSize), y0 = floorTo(lo.y(), kTopBlockSize);
         const int z0 = floorTo(lo.z(), kTopBlockSize);
         std::vector<Lists> lists(blocks[0] * blocks[1]);
         std::atomic<std::uint64_t> surfaceLeaves{0};
-        parallelForWithProgress(lists.size(), progress_.stage(BakeStage::Classifying, 0.0, split),
-                                [&](std::size_t column, const std::atomic<bool>& stop) {
-                                    const int x = x0 + int(column / blocks[1]) * kTopBlockSize;
-                                    const int y = y0 + int(column % blocks[1]) * kTopBlockSize;
-                                    std::uint64_t count = 0;
-                                    for (std::uint64_t k = 0; k < blocks[2] && !stop; ++k)
-                                        classifyBlock(Coord(x, y, z0 + int(k) * kTopBlockSize), kTopBlockSize,
-                                                      lists[column], count);
-                                    evaluated_ += count;
-                                    progress_.countEvaluations(count);
-                                    // Refuse early: the surface leaves alone already exceed the limit.
-                                    const std::uint64_t total = surfaceLeaves += lists[column].surface.size();
-                                    if (estimateFor(total) > limit_) checkMemory(total, false);
-                                });
+        parallelForWithProgress(lists.size(), progress, [&](std::size_t column, const std::atomic<bool>& stop) {
+            const int x = x0 + int(column / blocks[1]) * kTopBlockSize;
+            const int y = y0 + int(column % blocks[1]) * kTopBlockSize;
+            std::uint64_t count = 0;
+            for (std::uint64_t k = 0; k < blocks[2] && !stop; ++k)
+                classifyBlock(Coord(x, y, z0 + int(k) * kTopBlockSize), kTopBlockSize, lists[column], count);
+            evaluated_ += count;
+            progress_.countEvaluations(count);
+            // Refuse early: the surface leaves alone already exceed the limit.
+            const std::uint64_t total = surfaceLeaves += lists[column].surface.size();
+            if (estimateFor(total) > limit_.bytes) checkMemory(total, false);
+        });
+        // Into two lists of their exact size, each column's freed as it is taken: all the lists
+        // together never hold more than four Coords a leaf (countLeafLayersBytes counts on it).
+        std::size_t surfaceCount = 0, deferredCount = 0;
+        for (const Lists& list : lists) {
+            surfaceCount += list.surface.size();
+            deferredCount += list.deferred.size();
+        }
         std::vector<Coord> wave;
         std::vector<Coord> deferred;
-        for (const Lists& list : lists) {
+        wave.reserve(surfaceCount + deferredCount);  // the deferred leaves next to skipped space join it
+        deferred.reserve(deferredCount);
+        for (Lists& list : lists) {
             for (const Coord& origin : list.surface) {
                 states_.setValue(leafKey(origin), kSurface);
                 wave.push_back(origin);
@@ -291,6 +317,7 @@ private:
                 states_.setValue(leafKey(origin), kDeferred);
                 deferred.push_back(origin);
             }
+            list = Lists{};
         }
         // A deferred leaf next to skipped space touches outside values there: sample it.
         const std::vector<Coord> offsets = neighbourOffsets();
@@ -374,35 +401,27 @@ private:
         return leaves;
     }
 
-    std::uint64_t estimateFor(std::uint64_t leaves) const {
-        const double perLeaf = options_.dense ? kFloatLeafBytes : kFloatLeafBytes + memory_.bytesPerLeaf;
-        return std::uint64_t(memory_.fixedBytes + perLeaf * double(leaves));
-    }
+    std::uint64_t estimateFor(std::uint64_t leaves) const { return samplingEstimate(memory_, leaves, options_.dense); }
 
     /// Refuses (MemoryLimitError) when `leaves` sampled leaves would exceed the limit. `final`:
     /// the whole count after classification; otherwise a count still growing during it.
     void checkMemory(std::uint64_t leaves, bool final) {
         const std::uint64_t estimate = estimateFor(leaves);
         if (final) stats_.estimatedBytes = estimate;
-        if (estimate <= limit_) return;
-        const std::string limit = formatBytes(limit_) + limitSource_;
+        if (estimate <= limit_.bytes) return;
+        const std::string limit = limit_.text();
         const std::string blocks = std::to_string(leaves) + " blocks of 8^3 voxels to sample";
-        throw MemoryLimitError(
-            "resolution " + std::to_string(params_.bake.resolution) +
-                (final ? " needs an estimated " + formatBytes(estimate) + " (" + blocks + "), more than the limit of " +
-                             limit
-                 : leaves > 0 ? " needs more than the limit of " + limit + ": the first " + blocks + " already need " +
-                                    formatBytes(estimate)
-                              : " needs at least " + formatBytes(estimate) +
-                                    " before any voxel is sampled, more than "
-                                    "the limit of " +
-                                    limit) +
-                (processLimited_
-                     ? std::string(
-                           "; lower the resolution, bake a smaller region (bake.bounds) or raise the process's limit")
-                     : std::string(
-                           "; lower the resolution, bake a smaller region (bake.bounds) or raise the limit (--max-memory)")),
-            estimate, limit_);
+        throw MemoryLimitError("resolution " + std::to_string(params_.bake.resolution) +
+                                   (final ? " needs an estimated " + formatBytes(estimate) + " (" + blocks +
+                                                "), more than the limit of " + limit
+                                    : leaves > 0 ? " needs more than the limit of " + limit + ": the first " + blocks +
+                                                       " already need " + formatBytes(estimate)
+                                                 : " needs at least " + formatBytes(estimate) +
+                                                       " before any voxel is sampled, more than "
+                                                       "the limit of " +
+                                                       limit) +
+                                   limit_.advice(),
+                               estimate, limit_.bytes);
     }
 
     const Params& params_;
@@ -413,9 +432,8 @@ private:
     double h_;
     CoordBBox indexBox_;  // the voxels sampled: the whole bake's, or a tile's window of them
     std::uint64_t dense_ = 1;
-    std::uint64_t limit_ = 0;
-    std::string limitSource_;  // why the limit is what it is, for the message
-    bool processLimited_ = false;
+    bool slab_ = false;
+    SamplingLimit limit_;
     std::atomic<std::uint64_t> evaluated_{0};
     openvdb::Int32Tree states_{kSkipped};  // keyed by leaf (origin / 8)
     BakeStats stats_;
@@ -553,9 +571,123 @@ double bakeVoxelSize(const Params& params) {
 }
 
 SampledSurface sampleSurface(const Params& params, const BakeOptions& options, const MemoryModel& memory,
-                             StagedProgress& progress, double split, double end) {
-    Sampler sampler(params, options, memory, progress);
+                             StagedProgress& progress, double split, double end, const CoordBBox* window) {
+    Sampler sampler(params, options, memory, progress, window);
     return sampler.run(split, end);
+}
+
+std::uint64_t denseVoxels(const Params& params) {
+    const BakeRegion region(params);
+    const Box& box = region.box();
+    const double h = bakeVoxelSize(params);
+    std::uint64_t dense = 1;
+    for (int axis = 0; axis < 3; ++axis)
+        dense *= std::uint64_t(std::max<long long>(1, std::llround((box.max[axis] - box.min[axis]) / h)));
+    return dense;
+}
+
+std::uint64_t samplingEstimate(const MemoryModel& memory, std::uint64_t leaves, bool dense) {
+    const double perLeaf = dense ? kFloatLeafBytes : kFloatLeafBytes + memory.bytesPerLeaf;
+    return std::uint64_t(memory.fixedBytes + perLeaf * double(leaves));
+}
+
+SamplingLimit samplingMemoryLimit(const BakeOptions& options) {
+    // An explicit limit too is capped by what the process may really allocate (ulimit -v,
+    // cgroups): beyond that the bake would fail late with an allocation error.
+    const std::uint64_t processLimit = processMemoryHeadroom();
+    const std::uint64_t requested = options.memoryLimit ? options.memoryLimit : defaultMemoryLimit();
+    SamplingLimit limit;
+    limit.bytes = std::min(requested, processLimit);
+    limit.processLimited = processLimit <= requested;  // defaultMemoryLimit() too may be the process limit
+    limit.source = limit.processLimited  ? " (what this process may still allocate under its memory limits: ulimit -v, "
+                                           "ulimit -d or its cgroup's memory.max)"
+                   : options.memoryLimit ? ""
+                                         : " (half of the available memory)";
+    return limit;
+}
+
+std::string SamplingLimit::text() const { return formatBytes(bytes) + source; }
+
+std::string SamplingLimit::advice() const {
+    return processLimited
+               ? "; lower the resolution, bake a smaller region (bake.bounds) or raise the process's limit"
+               : "; lower the resolution, bake a smaller region (bake.bounds) or raise the limit (--max-memory)";
+}
+
+std::uint64_t countLeafLayersBytes(const Params& params) {
+    // A bound from the resolution alone. A chunk's classification, at worst (no leaf of its window
+    // proven empty), holds for each leaf of its window (the chunk's layers and one more on either
+    // side): a Coord in its column's list (up to twice that while the list grows), then in the wave
+    // and the deferred leaves (classify), four Coords a leaf at most; and a state in an Int32Tree
+    // keyed by leaf, whose leaf nodes (each with its 8^3 values, allocated apart from the node) the
+    // window touches up to 3 across x (10 keys) and all across y and z, with the internal nodes
+    // above them. At 16384 this is 2.5 GB (8192: 630 MB, 4096: 160 MB); measured there (default
+    // fractal, the middle chunk): 400 MB. (Counting sizeof(leaf node) alone, without its values,
+    // once gave 30 MB, and a 600 MB cap ran out here instead of refusing.)
+    const CoordBBox full = bakeIndexBox(params);
+    using StateTree = openvdb::Int32Tree;
+    using StateLeaf = StateTree::LeafNodeType;
+    using Lower = StateTree::RootNodeType::ChildNodeType::ChildNodeType;  // 16^3 leaf nodes
+    using Upper = StateTree::RootNodeType::ChildNodeType;                 // 32^3 lower nodes
+    constexpr std::uint64_t kAllocation = 64;                             // malloc's own, a block
+    auto across = [](std::uint64_t keys, std::uint64_t perNode) { return keys / perNode + 2; };
+    const std::uint64_t keysX = kChunkLayers + 2;
+    const std::uint64_t keysY = std::uint64_t(full.dim().y() / kLeafSize + 2);
+    const std::uint64_t keysZ = std::uint64_t(full.dim().z() / kLeafSize + 2);
+    const std::uint64_t lists = 4 * sizeof(Coord) * keysX * keysY * keysZ;
+    const std::uint64_t leafNodes = 3 * across(keysY, StateLeaf::DIM) * across(keysZ, StateLeaf::DIM);
+    const std::uint64_t lowerNodes = 2 * across(keysY, Lower::DIM) * across(keysZ, Lower::DIM);
+    const std::uint64_t upperNodes = 2 * across(keysY, Upper::DIM) * across(keysZ, Upper::DIM);
+    return lists + leafNodes * (sizeof(StateLeaf) + StateLeaf::SIZE * sizeof(std::int32_t) + 2 * kAllocation) +
+           lowerNodes * (sizeof(Lower) + kAllocation) + upperNodes * (sizeof(Upper) + kAllocation);
+}
+
+LeafLayers countLeafLayers(const Params& params, const BakeOptions& options, const ProgressCallback& progress,
+                           const LayersCounted& counted) {
+    const CoordBBox full = bakeIndexBox(params);
+    LeafLayers layers;
+    const int firstX = int(std::floor(double(full.min().x()) / kLeafSize)) * kLeafSize;
+    layers.first = firstX / kLeafSize;
+    const std::size_t count = std::size_t(full.max().x() - firstX) / kLeafSize + 1;
+    layers.sampled.assign(count, 0);
+    layers.deferred.assign(count, 0);
+    if (options.dense) {  // every leaf is sampled, nothing is classified
+        const Coord dim = full.dim();
+        const std::uint64_t perLayer = std::uint64_t((dim.y() + 2 * kLeafSize - 1) / kLeafSize) *
+                                       std::uint64_t((dim.z() + 2 * kLeafSize - 1) / kLeafSize);
+        layers.sampled.assign(count, perLayer);
+        return layers;
+    }
+    // Chunks of layers, each classified with a leaf more on either side, so that its deferred
+    // leaves see their true neighbours (the first wave takes those next to skipped space).
+    // From the middle outwards, where a solid is usually widest: a caller that refuses a layer
+    // too large for its limit does so after the first few chunks.
+    const std::size_t chunks = (count + kChunkLayers - 1) / kChunkLayers;
+    std::vector<std::size_t> order(chunks);
+    for (std::size_t chunk = 0; chunk < chunks; ++chunk) order[chunk] = chunk;
+    const double middle = 0.5 * double(chunks - 1);
+    std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        return std::abs(double(a) - middle) < std::abs(double(b) - middle);
+    });
+    BakeOptions quiet = options;
+    quiet.monitor = nullptr;
+    for (std::size_t step = 0; step < chunks; ++step) {
+        const std::size_t chunk = order[step];
+        const int x0 = firstX + int(chunk * kChunkLayers) * kLeafSize;
+        const CoordBBox box(Coord(x0, full.min().y(), full.min().z()),
+                            Coord(x0 + int(kChunkLayers) * kLeafSize - 1, full.max().y(), full.max().z()));
+        CoordBBox window = box;
+        window.expand(kLeafSize);
+        StagedProgress staged({}, nullptr);
+        Sampler sampler(params, quiet, MemoryModel{}, staged, &window);
+        const double begin = double(step) / double(chunks), end = double(step + 1) / double(chunks);
+        sampler.countLayers(layers, box,
+                            progress ? ProgressCallback(
+                                           [&](double fraction) { return progress(begin + fraction * (end - begin)); })
+                                     : ProgressCallback());
+        if (counted) counted(layers, chunk * kChunkLayers, std::min(count, (chunk + 1) * kChunkLayers));
+    }
+    return layers;
 }
 
 }  // namespace dqj

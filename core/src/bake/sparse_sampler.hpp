@@ -15,6 +15,9 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
 
 #include <glm/vec3.hpp>
 #include <openvdb/openvdb.h>
@@ -104,9 +107,56 @@ double bakeVoxelSize(const Params& params);
 openvdb::CoordBBox bakeIndexBox(const Params& params);
 
 /// Samples f for `params` (validated); with options.tile, only the tile's window of the whole
-/// bake's grid (tileWindow). Throws MemoryLimitError (before sampling) and Cancelled.
-/// Uses progress stages Classifying in [0, split] and Sampling in [split, end].
+/// bake's grid (tileWindow); with `window`, only that box of it (a slab of a streamed mesh). In a
+/// window, leaves stay where the whole bake has them and are classified and sampled as there, except
+/// that leaves inside the set next to the window's cut are sampled (the whole bake fills them
+/// with -eps unless the surface reaches them), so f is the whole bake's on every leaf a leaf or
+/// more inside the window, bar a pocket of outside inside the set the whole bake misses (above).
+/// Throws MemoryLimitError (before sampling) and Cancelled. Uses progress stages Classifying in
+/// [0, split] and Sampling in [split, end].
 SampledSurface sampleSurface(const Params& params, const BakeOptions& options, const MemoryModel& memory,
-                             StagedProgress& progress, double split, double end);
+                             StagedProgress& progress, double split, double end,
+                             const openvdb::CoordBBox* window = nullptr);
+
+/// The voxels in the bounds' box: what a dense bake of the whole evaluates (BakeStats::dense).
+std::uint64_t denseVoxels(const Params& params);
+
+/// The memory sampleSurface estimates for `leaves` sampled leaves and the later stages of
+/// `memory` (what it checks against the limit).
+std::uint64_t samplingEstimate(const MemoryModel& memory, std::uint64_t leaves, bool dense);
+
+/// The memory limit sampleSurface checks against: options.memoryLimit, or defaultMemoryLimit(),
+/// capped by processMemoryHeadroom(); and how messages name it.
+struct SamplingLimit {
+    std::uint64_t bytes = 0;
+    std::string source;           ///< why the limit is what it is: " (half of the available memory)", ...
+    bool processLimited = false;  ///< the process's own limits set it
+    std::string text() const;     ///< "2.0 GB (half of the available memory)"
+    std::string advice() const;   ///< "; lower the resolution, ... or raise the limit (--max-memory)"
+};
+SamplingLimit samplingMemoryLimit(const BakeOptions& options);
+
+/// Leaves counted by leaf layer along x: layer i holds the leaves whose origin's x is
+/// 8 (first + i). What a streamed mesh plans its slabs with (mesh_stream.hpp).
+struct LeafLayers {
+    int first = 0;
+    std::vector<std::uint64_t> sampled;   ///< leaves sampleSurface's first wave samples (dense: every leaf)
+    std::vector<std::uint64_t> deferred;  ///< leaves inside the set it samples only if the surface reaches them
+    std::uint64_t evaluated = 0;          ///< fractal evaluations the classification took
+};
+
+/// The most memory countLeafLayers may hold at once, from the resolution alone: a chunk's leaf
+/// lists and states with no leaf of it proven empty (2.5 GB at 16384, 630 MB at 8192).
+std::uint64_t countLeafLayersBytes(const Params& params);
+
+/// Called as each chunk of layers [first, end) has been counted (the others may still be 0).
+using LayersCounted = std::function<void(const LeafLayers& layers, std::size_t first, std::size_t end)>;
+
+/// The classification of sampleSurface alone, over the whole bake's grid in chunks of 64 voxels
+/// along x (each with a leaf more on either side, so the counts are the whole bake's), from the
+/// middle outwards: its leaves by layer, nothing sampled, no memory check. Memory: a chunk's
+/// classification. Throws Cancelled, and what `counted` throws.
+LeafLayers countLeafLayers(const Params& params, const BakeOptions& options, const ProgressCallback& progress,
+                           const LayersCounted& counted = {});
 
 }  // namespace dqj

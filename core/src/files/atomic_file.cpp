@@ -369,6 +369,44 @@ std::string AtomicFile::lowercaseExtension(const std::string& path) {
     return extension;
 }
 
+struct ScratchFile::State {
+    int fd = -1;
+    std::unique_ptr<CheckedBuffer> buffer;
+    std::unique_ptr<std::ostream> stream;
+};
+
+ScratchFile::ScratchFile(const std::string& path) : path_(path), state_(std::make_unique<State>()) {
+    State& state = *state_;
+    const std::string folder = folderOf(path_), prefix = platform::hiddenPrefix(path_);
+    state.fd = reported(path_, [&] { return platform::openScratchFile(folder, prefix); });
+    state.buffer = std::make_unique<CheckedBuffer>(state.fd);
+    state.stream = std::make_unique<std::ostream>(state.buffer.get());
+}
+
+ScratchFile::~ScratchFile() { platform::closeFile(state_->fd); }
+
+std::ostream& ScratchFile::stream() { return *state_->stream; }
+
+void ScratchFile::checkWrites() {
+    if (state_->buffer->error()) throw systemError(path_, state_->buffer->error());
+}
+
+void ScratchFile::appendTo(AtomicFile& target) {
+    State& state = *state_;
+    if (!state.buffer->drain()) checkWrites();  // throws: the write's reason
+    if (platform::seekTo(state.fd, 0, SEEK_SET) < 0) throw systemError(path_, errno);
+    std::vector<char> block(std::size_t(1) << 20);
+    std::ostream& out = target.stream();
+    for (;;) {
+        const std::int64_t got = platform::readSome(state.fd, block.data(), block.size());
+        if (got < 0 && errno == EINTR) continue;
+        if (got < 0) throw systemError(path_, errno);
+        if (got == 0) break;
+        out.write(block.data(), std::streamsize(got));
+    }
+    target.checkWrites();
+}
+
 void checkWritable(const std::string& path, Existing existing) {
     AtomicFile probe(path, existing);  // creates (and on destruction discards) a real temporary file there
 }

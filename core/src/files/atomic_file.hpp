@@ -13,6 +13,9 @@
 // used, held open so that no other writer removes it, and published with MoveFileExW. The steps on
 // the file system are platform::PendingFile's; the checks and their order are here.
 // AtomicFileSet publishes the several files of one run together: all of them or none.
+// ScratchFile holds data a writer sets aside until it goes into its AtomicFile (a streamed mesh's
+// faces, which follow all of its vertices): a file without a name beside the target, gone
+// whatever happens.
 #pragma once
 
 #include <cstdint>
@@ -96,6 +99,31 @@ private:
     /// Once the set is published: the hidden name of the file set aside is removed.
     void dropSetAside() noexcept;
 
+    std::string path_;
+    std::unique_ptr<State> state_;
+};
+
+/// Data set aside and later appended to an AtomicFile: a file in the folder of `path` (the
+/// target's disk, not /tmp's, which may be memory) that has no name, so nothing is ever left of it
+/// (platform::openScratchFile). Writes are buffered and checked as AtomicFile's.
+class ScratchFile {
+public:
+    /// Throws std::runtime_error ("cannot write 'path': reason") when the folder takes no file.
+    explicit ScratchFile(const std::string& path);
+    ~ScratchFile();
+    ScratchFile(const ScratchFile&) = delete;
+    ScratchFile& operator=(const ScratchFile&) = delete;
+
+    std::ostream& stream();
+    /// Throws std::runtime_error with the reason of the first failed write, if one failed.
+    void checkWrites();
+    /// Appends everything written so far to `target`'s stream. Throws std::runtime_error when a
+    /// write here failed or the data cannot be read back.
+    void appendTo(AtomicFile& target);
+
+    struct State;
+
+private:
     std::string path_;
     std::unique_ptr<State> state_;
 };

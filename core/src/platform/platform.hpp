@@ -180,6 +180,15 @@ private:
     std::unique_ptr<State> state_;
 };
 
+/// A file with no name in `folder`, open for reading and writing, for data a writer sets aside
+/// until it goes into its published file (a streamed mesh's faces): nothing is ever left of it,
+/// whatever happens to the process. Linux: O_TMPFILE, or where the file system has none a hidden name
+/// (`prefix` and six characters) removed as soon as it is made. Windows: a hidden name, open for this
+/// process alone, that the system deletes when it is closed (FILE_FLAG_DELETE_ON_CLOSE, also when the
+/// process dies), kept in memory where it can be (FILE_ATTRIBUTE_TEMPORARY). Returns a descriptor
+/// for readSome(), writeSome(), seekTo() and closeFile(). Throws FileError.
+int openScratchFile(const std::string& folder, const std::string& prefix);
+
 // --- Memory.
 
 /// What the system lets this process allocate beyond what it holds: the limits of ulimit (address

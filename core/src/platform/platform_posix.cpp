@@ -176,6 +176,20 @@ struct PendingFile::State {
     ino_t inode = 0;
 };
 
+int openScratchFile(const std::string& folder, const std::string& prefix) {
+    int fd = ::open(folder.c_str(), O_TMPFILE | O_RDWR | O_CLOEXEC, 0600);
+    if (fd < 0 && (errno == EOPNOTSUPP || errno == EISDIR || errno == EINVAL)) {
+        // No O_TMPFILE on this file system: a hidden name, gone again at once (the file stays open).
+        const std::string pattern = folder + "/" + prefix + "XXXXXX";
+        std::vector<char> buffer(pattern.begin(), pattern.end());
+        buffer.push_back('\0');
+        fd = ::mkostemp(buffer.data(), O_CLOEXEC);
+        if (fd >= 0) ::unlink(buffer.data());
+    }
+    if (fd < 0) throw systemError(errno);
+    return fd;
+}
+
 PendingFile::PendingFile(const std::string& folder, const std::string& prefix) : state_(std::make_unique<State>()) {
     State& state = *state_;
     state.folder = folder;

@@ -156,6 +156,25 @@ struct PendingFile::State {
     HANDLE asideHandle = INVALID_HANDLE_VALUE;  // holds the file set aside: no other writer deletes it
 };
 
+int openScratchFile(const std::string& folder, const std::string& prefix) {
+    // A new hidden name (CREATE_NEW), shared with no one, deleted by the system when closed.
+    HANDLE handle = INVALID_HANDLE_VALUE;
+    DWORD error = ERROR_FILE_EXISTS;
+    for (int attempt = 0; attempt < 100 && handle == INVALID_HANDLE_VALUE && error == ERROR_FILE_EXISTS; ++attempt) {
+        handle = ::CreateFileW(pathFromUtf8(hiddenName(folder, prefix)).c_str(), GENERIC_READ | GENERIC_WRITE, 0,
+                               nullptr, CREATE_NEW,
+                               FILE_ATTRIBUTE_HIDDEN | FILE_ATTRIBUTE_TEMPORARY | FILE_FLAG_DELETE_ON_CLOSE, nullptr);
+        if (handle == INVALID_HANDLE_VALUE) error = ::GetLastError();
+    }
+    if (handle == INVALID_HANDLE_VALUE) throw windowsError(error);
+    const int fd = ::_open_osfhandle(reinterpret_cast<intptr_t>(handle), _O_BINARY);
+    if (fd < 0) {
+        ::CloseHandle(handle);  // deletes it
+        throw FileError("cannot open the scratch file");
+    }
+    return fd;
+}
+
 PendingFile::PendingFile(const std::string& folder, const std::string& prefix) : state_(std::make_unique<State>()) {
     State& state = *state_;
     state.folder = folder;
