@@ -24,7 +24,7 @@ from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
 
 from . import native
 
-_active: List[Job] = []  # running jobs, for the panels
+_active: List[Job] = []  # running jobs and held ones (Job.hold), for the panels
 _lock = threading.Lock()
 
 
@@ -249,7 +249,6 @@ class Job:
         self._progress: Optional[native.Progress] = None
         self._cancel = threading.Event()
         self._thread: Optional[threading.Thread] = None
-        self._held = False  # in _active (held for a modal operator, or started)
         self.started = time.monotonic()
         self.finished: Optional[float] = None
 
@@ -298,8 +297,7 @@ class Job:
         progress report; a held job that never started is cancelled at once."""
         self._cancel.set()
         with _lock:
-            if self._held and self._thread is None:
-                self._held = False
+            if self._thread is None and self in _active:  # held, never started
                 _active.remove(self)
                 self.state, self.error, self.finished = Job.CANCELLED, "cancelled", time.monotonic()
         progress = self._progress
@@ -364,8 +362,7 @@ class Job:
         """Counts the job as active (active_jobs, the panels, cancel_all) before its worker
         starts: a modal operator starts it at its first timer tick (modal_job.py says why)."""
         with _lock:
-            if not self._held:
-                self._held = True
+            if self not in _active:
                 _active.append(self)
 
     def start(self) -> None:
@@ -374,8 +371,7 @@ class Job:
         with _lock:
             if self.state != Job.RUNNING or self._thread is not None:
                 return
-            if not self._held:
-                self._held = True
+            if self not in _active:
                 _active.append(self)
             thread = threading.Thread(target=self._thread_main, name="dqjulia-" + self.label, daemon=True)
             self._thread = thread
@@ -386,7 +382,6 @@ class Job:
             self.run()
         finally:
             with _lock:
-                self._held = False
                 if self in _active:
                     _active.remove(self)
 

@@ -1,8 +1,9 @@
 """A background Job driven by a modal operator: the one skeleton of the bakes (operators.py) and
 the Variations grid (variations.py).
 
-The operator's execute() calls run_job(). In the background, without a window, or when asked to
-be synchronous, the job runs in the calling thread and job_finished() gives the result at once.
+The operator (which has a `synchronous` property) calls run_job() from execute(). In the
+background, without a window, or when asked to be synchronous, the job runs in the calling thread
+and job_finished() gives the result at once.
 Otherwise the job is held (jobs.active_jobs counts it), a timer and a modal handler are added,
 and the worker thread starts at the first timer tick; each tick then calls job_ticked(); Esc
 cancels; when the worker is done, job_finished() runs on the main thread.
@@ -15,6 +16,8 @@ after the operators have returned, it never did.
 """
 
 from __future__ import annotations
+
+import bpy
 
 from . import jobs
 
@@ -49,9 +52,9 @@ class ModalJob:
         return False
 
     # the skeleton -----------------------------------------------------------------------
-    def run_job(self, context, job: jobs.Job, synchronous: bool) -> set:
+    def run_job(self, context, job: jobs.Job) -> set:
         self._job = job
-        if synchronous:
+        if self.synchronous or bpy.app.background or context.window is None:
             job.run()
             return self.job_finished(context)
         job.hold()

@@ -322,8 +322,7 @@ class _BakeOperator(ModalJob):
             self.report({"ERROR"}, str(error))
             return {"CANCELLED"}
         self._source_name = obj.name
-        synchronous = self.synchronous or bpy.app.background or context.window is None
-        return self.run_job(context, job, synchronous)
+        return self.run_job(context, job)
 
     def invoke(self, context, _event):
         return self.execute(context)

@@ -335,8 +335,7 @@ class DQJULIA_OT_variations_refresh(ModalJob, bpy.types.Operator):
         self._grid, self._name = new_grid(obj), obj.name
         if self._grid.job is None:
             return self.job_finished(context)
-        synchronous = self.synchronous or bpy.app.background or context.window is None
-        return self.run_job(context, self._grid.job, synchronous)
+        return self.run_job(context, self._grid.job)
 
     def invoke(self, context, _event):
         return self.execute(context)
