@@ -256,11 +256,17 @@ def c_examples(args):
         if built.returncode != 0:
             print(built.stdout + built.stderr)
             continue
-        ran = subprocess.run([str(program)], capture_output=True, text=True, check=False, cwd=work)
-        print(ran.stdout + ran.stderr)
-        checks["c-api.md:%d runs and succeeds" % line] = ran.returncode == 0
-        checks["c-api.md:%d printed its results" % line] = "rendered 64x48" in ran.stdout and "refused:" in ran.stdout
+        run_example(program, "c-api.md:%d" % line, checks, cwd=work)
     return report(checks)
+
+
+def run_example(program, label, checks, cwd=None):
+    """Runs an example program of the C and C++ API page: it succeeds and prints its results
+    (the render's size and the refused input's message)."""
+    ran = subprocess.run([str(program)], capture_output=True, text=True, check=False, cwd=cwd)
+    print(ran.stdout + ran.stderr)
+    checks["%s runs and succeeds" % label] = ran.returncode == 0
+    checks["%s printed its results" % label] = "rendered 64x48" in ran.stdout and "refused:" in ran.stdout
 
 
 def extract_cpp(args):
@@ -280,11 +286,7 @@ def extract_cpp(args):
 def cpp_examples(args):
     checks = {"the C and C++ API page has C++ examples, built": bool(args.program)}
     for program in args.program:
-        name = Path(program).name
-        ran = subprocess.run([program], capture_output=True, text=True, check=False)
-        print(ran.stdout + ran.stderr)
-        checks["%s runs and succeeds" % name] = ran.returncode == 0
-        checks["%s printed its results" % name] = "rendered 64x48" in ran.stdout and "refused:" in ran.stdout
+        run_example(program, Path(program).name, checks)
     return report(checks)
 
 
