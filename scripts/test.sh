@@ -14,9 +14,16 @@ scripts/install-deps.sh --windows  # what both builds need (after scripts/quicks
 # background: network and disk more than CPU, beside the builds' compiling. The builds'
 # configure steps look for all of them, so when anything was new, both builds are configured
 # again once it is there (seconds: nothing recompiles).
+# Not as root, sudo may ask for a password, which it cannot in the background: the packages are
+# then installed first.
+tests_packages=scripts/install-deps.sh
+if [ "$(id -u)" -ne 0 ]; then
+  scripts/install-deps.sh
+  tests_packages=true
+fi
 background_log="$(mktemp)"
 trap 'rm -f "$background_log"' EXIT
-(scripts/install-deps.sh && scripts/bpy-env.sh && scripts/tool-env.sh ruff && scripts/tool-env.sh mypy && scripts/tool-env.sh openjd && scripts/tool-env.sh twine && scripts/tool-env.sh auditwheel && scripts/tool-env.sh sphinx) >"$background_log" 2>&1 &
+("$tests_packages" && scripts/bpy-env.sh && scripts/tool-env.sh ruff && scripts/tool-env.sh mypy && scripts/tool-env.sh openjd && scripts/tool-env.sh twine && scripts/tool-env.sh auditwheel && scripts/tool-env.sh sphinx) >"$background_log" 2>&1 &
 background=$!
 scripts/build-deps.sh >/dev/null
 scripts/build.sh
