@@ -67,9 +67,13 @@ void checkChoice(const Field& field, const Json& value, const std::string& key, 
     if (value.is_string())
         for (const schema::Choice& choice : field.choices)
             if (value.get<std::string>() == choice.name) return;
-    fail(key, prefix,
-         "must be one of " + choiceList(field) + ", got " +
-             (value.is_string() ? "\"" + inputExcerpt(value.get_ref<const std::string&>()) + "\"" : describe(value)));
+    std::string got = describe(value);
+    if (value.is_string()) {  // appended, not "\"" + ...: GCC 12's -Wrestrict misreads that (a false warning)
+        got = "\"";
+        got += inputExcerpt(value.get_ref<const std::string&>());
+        got += '"';
+    }
+    fail(key, prefix, "must be one of " + choiceList(field) + ", got " + got);
 }
 
 namespace {
