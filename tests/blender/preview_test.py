@@ -17,8 +17,8 @@
 5. The Variations panel: Refresh runs modal (it returns at once, the library's thumbnails arrive
    in image previews while Blender's timers keep running), the panel draws its grid, and Esc
    stops a Refresh.
-With --screenshots DIR it also saves the README's screenshots there (and the Variations panel's,
-docs/images/blender-variations.png).
+With --screenshots DIR it also saves the documentation's screenshots there (docs/images/
+blender-preview.png, blender-bakes.png, blender-variations.png; docs/make-pictures.sh runs it so).
 Blender runs this from timers; the exit status is 0 only if every check passed.
 """
 
@@ -207,41 +207,8 @@ def step_first_render(obj):
             0.7 <= ratio <= 1.4,
             "the volume is about as bright as the mesh under the same light: %.2f times (0.7 .. 1.4)" % ratio,
         )
-    if ARGS.screenshots:
-        readme_renders(obj, view)
     for child in obj.children:
         child.hide_render = False
-
-
-def readme_renders(obj, view):
-    """The README's pictures of the default scene: the viewport preview and the Cycles renders
-    of the default volume and mesh bakes, from the factory camera, over its world colour."""
-    width, height = 480, 270
-    scene = bpy.context.scene
-    world = tuple(scene.world.node_tree.nodes["Background"].inputs[0].default_value[:3])
-    scene.view_settings.view_transform = "Standard"  # the colours the CLI writes
-    projection = scene.camera.calc_matrix_camera(bpy.context.evaluated_depsgraph_get(), x=width, y=height)
-    _drew, rgba, _mask = offscreen_preview(obj, view, projection, width, height)
-    for index in range(width * height):
-        alpha = rgba[4 * index + 3]
-        for channel in range(3):
-            rgba[4 * index + channel] += (1.0 - alpha) * world[channel]
-        rgba[4 * index + 3] = 1.0
-    image = bpy.data.images.new("readme preview", width, height, alpha=False, float_buffer=True)
-    image.pixels.foreach_set(rgba)
-    scene.render.image_settings.file_format = "PNG"
-    scene.render.image_settings.color_mode = "RGB"
-    image.save_render(os.path.join(ARGS.screenshots, "blender-default-preview.png"), scene=scene)
-    bpy.data.images.remove(image)
-    scene.render.film_transparent = False
-    scene.cycles.samples = 128
-    scene.render.resolution_x, scene.render.resolution_y = width, height
-    for kind in ("volume", "mesh"):
-        for child in obj.children:
-            child.hide_render = child.get("dqjulia_bake") != kind
-        scene.render.filepath = os.path.join(ARGS.screenshots, "blender-default-%s.png" % kind)
-        bpy.ops.render.render(write_still=True)
-        report("saved %s" % scene.render.filepath)
 
 
 def save_linear(rgba, width, height, name):
