@@ -7,9 +7,9 @@
 #
 #   --build DIR  a build tree with bin/dqjulia and dist/dqjulia_blender.zip (build)
 #   --out DIR    where the pictures go (docs/images)
-#   --only       some of the steps: cli (seconds), povray (about 2 minutes on 2 cores),
-#                blender-window and blender-renders (Debian's Blender under xvfb-run: about 8
-#                and 2 minutes)
+#   --only       some of the steps, comma-separated: cli (seconds), povray (5.5 minutes of CPU,
+#                about 3 on 2 idle cores), blender-window and blender-renders (Debian's Blender
+#                under xvfb-run: about 8 minutes, and 1)
 #   --list       one "STEP FILE" line for each picture (the docs tests compare it with the
 #                pictures the pages show)
 #
@@ -39,18 +39,23 @@ PICTURES=(
 )
 STEPS=(cli povray blender-window blender-renders)
 
-usage() { sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
+usage() { sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; }
 build=$root/build
 out=$root/docs/images
 only=
 while [ $# -gt 0 ]; do
   case "$1" in
     --list) printf '%s\n' "${PICTURES[@]}"; exit 0 ;;
-    --build) build=$(cd "${2:?--build needs a folder}" && pwd); shift 2 ;;
-    --out) out=${2:?--out needs a folder}; shift 2 ;;
-    --only) only=${2:?--only needs steps}; shift 2 ;;
-    -h | --help) usage ;;
-    *) echo "make-pictures.sh: unknown argument '$1'" >&2; usage ;;
+    --build | --out | --only)
+      [ $# -ge 2 ] || { echo "make-pictures.sh: $1 needs a value" >&2; exit 2; }
+      case "$1" in
+        --build) build=$(cd "$2" && pwd) ;;
+        --out) out=$2 ;;
+        --only) only=$2 ;;
+      esac
+      shift 2 ;;
+    -h | --help) usage; exit 0 ;;
+    *) echo "make-pictures.sh: unknown argument '$1'" >&2; usage >&2; exit 2 ;;
   esac
 done
 steps=("${STEPS[@]}")

@@ -39,23 +39,35 @@ SHOWN = (
 )
 
 
+def targets(text):
+    """The pictures a page's text shows, in the order of SHOWN's patterns."""
+    return [target for pattern in SHOWN for target in pattern.findall(text)]
+
+
+SAMPLE = (
+    'A ![alt *text*](images/a.png "title") and <img alt="b" src="images/b.png"> in a line,\n'
+    "```{figure} images/c.png\n:alt: c\n```\n:::{image} ../docs/images/d.png\n:::\n[a link](images/e.png)\n"
+)
+
+
 def shown_pictures():
     """{picture file under docs/images: [pages showing it]}, and the shown pictures that are not
     under docs/images (as 'page: target')."""
     shown, elsewhere = {}, []
     for page in [ROOT / "README.md", *sorted(DOCS.glob("*.md"))]:
         text = page.read_text(encoding="utf-8")
-        for pattern in SHOWN:
-            for target in pattern.findall(text):
-                if re.match(r"[a-z]+:", target):
-                    elsewhere.append("%s: %s" % (page.name, target))
-                    continue
-                path = (page.parent / target.split("#")[0]).resolve()
-                if path.parent != IMAGES:
-                    elsewhere.append("%s: %s" % (page.name, target))
-                    continue
+        for target in targets(text):
+            path = (page.parent / target.split("#")[0]).resolve()
+            if re.match(r"[a-z]+:", target) or path.parent != IMAGES:
+                elsewhere.append("%s: %s" % (page.name, target))
+            else:
                 shown.setdefault(path.name, []).append(page.name)
     return shown, elsewhere
+
+
+def named(names):
+    """': a, b' for a check's name, or nothing."""
+    return ": " + ", ".join(names) if names else ""
 
 
 def png_size(path):
@@ -74,9 +86,16 @@ def main():
     if not shutil.which("optipng"):
         skip_or_fail("optipng is not installed (scripts/install-deps.sh installs it)")
     checks = {}
+    found = targets(SAMPLE)
+    checks["the pictures of Markdown, HTML and MyST's directives are found, links are not: %s" % found] = found == [
+        "images/a.png",
+        "images/b.png",
+        "images/c.png",
+        "../docs/images/d.png",
+    ]
 
     listed = subprocess.run([str(SCRIPT), "--list"], capture_output=True, text=True, check=False)
-    checks["make-pictures.sh --list succeeds%s" % (": " + listed.stderr.strip() if listed.returncode else "")] = (
+    checks["make-pictures.sh --list succeeds" + named([listed.stderr.strip()] if listed.returncode else [])] = (
         listed.returncode == 0
     )
     lines = [line.split() for line in listed.stdout.splitlines() if line.strip()]
@@ -90,23 +109,16 @@ def main():
     made = set(steps)
 
     shown, elsewhere = shown_pictures()
-    checks["every picture the pages show is in docs/images%s" % (": " + ", ".join(elsewhere) if elsewhere else "")] = (
-        not elsewhere
-    )
-    unmade = sorted(set(shown) - made)
+    checks["every picture the pages show is in docs/images" + named(elsewhere)] = not elsewhere
+    unmade = ["%s (%s)" % (name, ", ".join(shown[name])) for name in sorted(set(shown) - made)]
     checks[
-        "every picture the pages and the README show (%d) is one make-pictures.sh makes%s"
-        % (len(shown), ": not " + ", ".join("%s (%s)" % (name, ", ".join(shown[name])) for name in unmade) if unmade else "")
+        "every picture the pages and the README show (%d) is one make-pictures.sh makes" % len(shown) + named(unmade)
     ] = bool(shown) and not unmade
     unshown = sorted(made - set(shown))
-    checks["every picture make-pictures.sh makes is shown%s" % (": not " + ", ".join(unshown) if unshown else "")] = (
-        not unshown
-    )
+    checks["every picture make-pictures.sh makes is shown" + named(unshown)] = not unshown
     present = {path.name for path in IMAGES.iterdir()}
-    stray, missing = sorted(present - made), sorted(made - present)
-    checks["docs/images holds exactly those pictures%s" % (": " + ", ".join(stray + missing) if stray or missing else "")] = (
-        not stray and not missing
-    )
+    odd = sorted(present ^ made)
+    checks["docs/images holds exactly those pictures" + named(odd)] = not odd
     for name in sorted(made & present):
         path = IMAGES / name
         size_kb = path.stat().st_size / 1024
@@ -135,7 +147,7 @@ def main():
             made_size is not None and made_size == committed
         )
     extra = sorted({path.name for path in out.iterdir()} - set(quick)) if out.is_dir() else []
-    checks["--out holds nothing but the step's pictures%s" % (": " + ", ".join(extra) if extra else "")] = not extra
+    checks["--out holds nothing but the step's pictures" + named(extra)] = not extra
     return report(checks)
 
 
