@@ -39,7 +39,7 @@ from preview_compare import look_at, offscreen_preview  # noqa: E402
 
 
 def extra_arguments(parser):
-    parser.add_argument("--screenshots", default="", help="save README screenshots to this folder")
+    parser.add_argument("--screenshots", default="", help="save the documentation's screenshots to this folder")
     parser.add_argument(
         "--variations-scroll", type=int, default=8, help="steps the sidebar scrolls down to the Variations panel"
     )
@@ -300,7 +300,7 @@ def _show_sidebar_tab(area):
 
 
 def save_screenshots(obj):
-    """The README's screenshots (docs/images): the live preview with the sidebar panel, and the
+    """The documentation's screenshots (docs/images): the live preview with the sidebar panel, and the
     bakes (mesh, volume) beside the preview. Generator: yields to let Blender redraw."""
     directory = ARGS.screenshots
     os.makedirs(directory, exist_ok=True)
@@ -347,6 +347,7 @@ def save_screenshots(obj):
             child.location = (3.2, 0.0, 0.0)
         elif kind == "volume":
             child.location = (-3.2, 0.0, 0.0)
+            child.hide_viewport = False  # the modal bake's step hid its volume (llvmpipe draws it slowly)
     space.shading.type = "SOLID"
     space.shading.color_type = "VERTEX"
     rv3d.view_matrix = look_at((1.5, -9.6, 2.6), (1.5, 0.0, 0.0), (0.0, 0.0, 1.0))
@@ -548,19 +549,7 @@ def variations_screenshot(obj, refresh):
     # Widen the sidebar as a user does, dragging its left edge, then scroll down to the panel.
     sidebar = next(r for r in area.regions if r.type == "UI")
     narrow = sidebar.width
-    for offset in (0, 2, 4, -2, 6):
-        x, y = sidebar.x + offset, sidebar.y + sidebar.height // 3
-        window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x, y=y)
-        yield 0.1
-        window.event_simulate(type="LEFTMOUSE", value="PRESS", x=x, y=y)
-        yield 0.1
-        for step in range(1, 11):
-            window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x - 16 * step, y=y)
-            yield 0.05
-        window.event_simulate(type="LEFTMOUSE", value="RELEASE", x=x - 160, y=y)
-        yield 0.3
-        if sidebar.width > narrow:
-            break
+    yield from _drag_sidebar_edge(window, sidebar, -160)
     report("the sidebar is %d pixels wide (was %d)" % (sidebar.width, narrow))
     for _ in range(ARGS.variations_scroll):
         with bpy.context.temp_override(window=window, area=area, region=sidebar):
@@ -569,6 +558,31 @@ def variations_screenshot(obj, refresh):
         redraw()
         yield 0.2
     _shot(os.path.join(ARGS.screenshots, "blender-variations.png"), scale=1.0)
+    # Back as it was for the screenshots that follow: scrolled to the top, as narrow as before.
+    for _ in range(ARGS.variations_scroll):
+        with bpy.context.temp_override(window=window, area=area, region=sidebar):
+            bpy.ops.view2d.scroll_up(deltax=0, deltay=40)
+    yield from _drag_sidebar_edge(window, sidebar, sidebar.width - narrow)
+    report("the sidebar is %d pixels wide again (was %d)" % (sidebar.width, narrow))
+
+
+def _drag_sidebar_edge(window, sidebar, distance):
+    """Drags the sidebar's left edge `distance` pixels to the right (negative: wider), as a user
+    does, from a few points about the edge until its width changes. Generator."""
+    before = sidebar.width
+    for offset in (0, 2, 4, -2, 6):
+        x, y = sidebar.x + offset, sidebar.y + sidebar.height // 3
+        window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x, y=y)
+        yield 0.1
+        window.event_simulate(type="LEFTMOUSE", value="PRESS", x=x, y=y)
+        yield 0.1
+        for step in range(1, 11):
+            window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x + distance * step // 10, y=y)
+            yield 0.05
+        window.event_simulate(type="LEFTMOUSE", value="RELEASE", x=x + distance, y=y)
+        yield 0.3
+        if sidebar.width != before:
+            break
 
 
 def close_splash():
