@@ -9,7 +9,7 @@
 #   --out DIR    where the pictures go (docs/images)
 #   --only       some of the steps, comma-separated: cli (seconds), povray (5.5 minutes of CPU,
 #                about 3 on 2 idle cores), blender-window and blender-renders (Debian's Blender
-#                under xvfb-run: about 8 minutes, and 1)
+#                under xvfb-run: 3 to 4 minutes, and 1); all of them about 7 minutes on 2 cores
 #   --list       one "STEP FILE" line for each picture (the docs tests compare it with the
 #                pictures the pages show)
 #
