@@ -29,6 +29,7 @@ test_packages=(
   libegl1 libgl1-mesa-dri mesa-vulkan-drivers  # the bpy wheels 5.2+ draw the preview without a window: EGL and Vulkan on Mesa's llvmpipe and lavapipe
   python3-openvdb python3-numpy  # tests/cli/pyopenvdb_test.py: a bake read by Debian's own OpenVDB
   povray  # tests/povray evaluate dqjulia.inc and render generated scenes in the real POV-Ray 3.7
+  optipng  # docs/make-pictures.sh makes the pictures smaller without loss (docs.pictures runs its quick step)
   clang-format clang-tidy  # scripts/check-style.sh (the test style.check); ruff comes from scripts/tool-env.sh ruff
   slurm-wlm munge  # tests/farm: a one-node Slurm cluster on localhost runs a frame array and a tiled bake
   wine64  # the Windows build's tests (tests/windows)

@@ -17,8 +17,8 @@
 5. The Variations panel: Refresh runs modal (it returns at once, the library's thumbnails arrive
    in image previews while Blender's timers keep running), the panel draws its grid, and Esc
    stops a Refresh.
-With --screenshots DIR it also saves the README's screenshots there (and the Variations panel's,
-docs/images/blender-variations.png).
+With --screenshots DIR it also saves the documentation's screenshots there (docs/images/
+blender-preview.png, blender-bakes.png, blender-variations.png; docs/make-pictures.sh runs it so).
 Blender runs this from timers; the exit status is 0 only if every check passed.
 """
 
@@ -39,7 +39,7 @@ from preview_compare import look_at, offscreen_preview  # noqa: E402
 
 
 def extra_arguments(parser):
-    parser.add_argument("--screenshots", default="", help="save README screenshots to this folder")
+    parser.add_argument("--screenshots", default="", help="save the documentation's screenshots to this folder")
     parser.add_argument(
         "--variations-scroll", type=int, default=8, help="steps the sidebar scrolls down to the Variations panel"
     )
@@ -207,41 +207,8 @@ def step_first_render(obj):
             0.7 <= ratio <= 1.4,
             "the volume is about as bright as the mesh under the same light: %.2f times (0.7 .. 1.4)" % ratio,
         )
-    if ARGS.screenshots:
-        readme_renders(obj, view)
     for child in obj.children:
         child.hide_render = False
-
-
-def readme_renders(obj, view):
-    """The README's pictures of the default scene: the viewport preview and the Cycles renders
-    of the default volume and mesh bakes, from the factory camera, over its world colour."""
-    width, height = 480, 270
-    scene = bpy.context.scene
-    world = tuple(scene.world.node_tree.nodes["Background"].inputs[0].default_value[:3])
-    scene.view_settings.view_transform = "Standard"  # the colours the CLI writes
-    projection = scene.camera.calc_matrix_camera(bpy.context.evaluated_depsgraph_get(), x=width, y=height)
-    _drew, rgba, _mask = offscreen_preview(obj, view, projection, width, height)
-    for index in range(width * height):
-        alpha = rgba[4 * index + 3]
-        for channel in range(3):
-            rgba[4 * index + channel] += (1.0 - alpha) * world[channel]
-        rgba[4 * index + 3] = 1.0
-    image = bpy.data.images.new("readme preview", width, height, alpha=False, float_buffer=True)
-    image.pixels.foreach_set(rgba)
-    scene.render.image_settings.file_format = "PNG"
-    scene.render.image_settings.color_mode = "RGB"
-    image.save_render(os.path.join(ARGS.screenshots, "blender-default-preview.png"), scene=scene)
-    bpy.data.images.remove(image)
-    scene.render.film_transparent = False
-    scene.cycles.samples = 128
-    scene.render.resolution_x, scene.render.resolution_y = width, height
-    for kind in ("volume", "mesh"):
-        for child in obj.children:
-            child.hide_render = child.get("dqjulia_bake") != kind
-        scene.render.filepath = os.path.join(ARGS.screenshots, "blender-default-%s.png" % kind)
-        bpy.ops.render.render(write_still=True)
-        report("saved %s" % scene.render.filepath)
 
 
 def save_linear(rgba, width, height, name):
@@ -333,7 +300,7 @@ def _show_sidebar_tab(area):
 
 
 def save_screenshots(obj):
-    """The README's screenshots (docs/images): the live preview with the sidebar panel, and the
+    """The documentation's screenshots (docs/images): the live preview with the sidebar panel, and the
     bakes (mesh, volume) beside the preview. Generator: yields to let Blender redraw."""
     directory = ARGS.screenshots
     os.makedirs(directory, exist_ok=True)
@@ -380,6 +347,7 @@ def save_screenshots(obj):
             child.location = (3.2, 0.0, 0.0)
         elif kind == "volume":
             child.location = (-3.2, 0.0, 0.0)
+            child.hide_viewport = False  # the modal bake's step hid its volume (llvmpipe draws it slowly)
     space.shading.type = "SOLID"
     space.shading.color_type = "VERTEX"
     rv3d.view_matrix = look_at((1.5, -9.6, 2.6), (1.5, 0.0, 0.0), (0.0, 0.0, 1.0))
@@ -581,19 +549,7 @@ def variations_screenshot(obj, refresh):
     # Widen the sidebar as a user does, dragging its left edge, then scroll down to the panel.
     sidebar = next(r for r in area.regions if r.type == "UI")
     narrow = sidebar.width
-    for offset in (0, 2, 4, -2, 6):
-        x, y = sidebar.x + offset, sidebar.y + sidebar.height // 3
-        window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x, y=y)
-        yield 0.1
-        window.event_simulate(type="LEFTMOUSE", value="PRESS", x=x, y=y)
-        yield 0.1
-        for step in range(1, 11):
-            window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x - 16 * step, y=y)
-            yield 0.05
-        window.event_simulate(type="LEFTMOUSE", value="RELEASE", x=x - 160, y=y)
-        yield 0.3
-        if sidebar.width > narrow:
-            break
+    yield from _drag_sidebar_edge(window, sidebar, -160)
     report("the sidebar is %d pixels wide (was %d)" % (sidebar.width, narrow))
     for _ in range(ARGS.variations_scroll):
         with bpy.context.temp_override(window=window, area=area, region=sidebar):
@@ -602,6 +558,31 @@ def variations_screenshot(obj, refresh):
         redraw()
         yield 0.2
     _shot(os.path.join(ARGS.screenshots, "blender-variations.png"), scale=1.0)
+    # Back as it was for the screenshots that follow: scrolled to the top, as narrow as before.
+    for _ in range(ARGS.variations_scroll):
+        with bpy.context.temp_override(window=window, area=area, region=sidebar):
+            bpy.ops.view2d.scroll_up(deltax=0, deltay=40)
+    yield from _drag_sidebar_edge(window, sidebar, sidebar.width - narrow)
+    report("the sidebar is %d pixels wide again (was %d)" % (sidebar.width, narrow))
+
+
+def _drag_sidebar_edge(window, sidebar, distance):
+    """Drags the sidebar's left edge `distance` pixels to the right (negative: wider), as a user
+    does, from a few points about the edge until its width changes. Generator."""
+    before = sidebar.width
+    for offset in (0, 2, 4, -2, 6):
+        x, y = sidebar.x + offset, sidebar.y + sidebar.height // 3
+        window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x, y=y)
+        yield 0.1
+        window.event_simulate(type="LEFTMOUSE", value="PRESS", x=x, y=y)
+        yield 0.1
+        for step in range(1, 11):
+            window.event_simulate(type="MOUSEMOVE", value="NOTHING", x=x + distance * step // 10, y=y)
+            yield 0.05
+        window.event_simulate(type="LEFTMOUSE", value="RELEASE", x=x + distance, y=y)
+        yield 0.3
+        if sidebar.width != before:
+            break
 
 
 def close_splash():
