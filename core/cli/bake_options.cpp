@@ -211,18 +211,19 @@ MeshScale BakeFlags::meshScale() const {
             throw ParamError("mesh.units", "--units \"" + inputExcerpt(units) + "\": expected mm, cm, m or in");
         scale.unit = known->second;
     }
-    if (size.empty()) return scale;
+    if (!size) return scale;
+    const std::string& text = *size;
     if (units.empty())
-        throw ParamError("mesh.size", "--size " + inputExcerpt(size) +
+        throw ParamError("mesh.size", "--size " + inputExcerpt(text) +
                                           " needs --units (mm, cm, m or in): a print's size means nothing without one");
     std::size_t used = 0;
     try {
-        scale.size = std::stod(size, &used);
+        scale.size = std::stod(text, &used);  // nan and inf too: checkMeshScale refuses them
     } catch (const std::exception&) {
         used = 0;
     }
-    if (used == 0 || used != size.size())
-        throw ParamError("mesh.size", "--size \"" + inputExcerpt(size) + "\": expected a number, e.g. 120");
+    if (used == 0 || used != text.size())
+        throw ParamError("mesh.size", "--size \"" + inputExcerpt(text) + "\": expected a number, e.g. 120");
     checkMeshScale(scale);
     return scale;
 }

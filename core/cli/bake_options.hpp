@@ -38,7 +38,8 @@ struct BakeFlags {
     std::string maxMemory;
     std::optional<double> adaptivity;  // mesh only
     bool noColors = false;             // mesh only
-    std::string units, size;           // mesh only: --units, --size (meshScale)
+    std::string units;                 // mesh only: --units (meshScale)
+    std::optional<std::string> size;   // mesh only: --size, as given (meshScale)
     std::string tiles;                 // bake and farm
     std::optional<int> tile;           // bake only
     std::optional<int> threads;        // bake and mesh

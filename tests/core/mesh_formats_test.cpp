@@ -142,7 +142,7 @@ TEST_F(MeshFormats, SizeScalesTheLargestSideAndMovesTheMeshIntoThePositiveOctant
 TEST_F(MeshFormats, NonsenseSizesAndExtensionsAreRefusedBeforeAnyFile) {
     const Mesh mesh = bakeMesh(defaultAt(24));
     const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
-    for (const double size : {-1.0, -0.0001, nan, inf, -inf, 1e6 + 1, 1e300}) {
+    for (const double size : {0.0, -1.0, -0.0001, nan, inf, -inf, 1e6 + 1, 1e300}) {
         EXPECT_THROW(checkMeshScale({MeshUnit::Millimeter, size}), ParamError) << size;
         EXPECT_THROW(writeMesh(mesh, path("m.stl"), Existing::Replace, {MeshUnit::Millimeter, size}), ParamError);
     }
@@ -150,7 +150,7 @@ TEST_F(MeshFormats, NonsenseSizesAndExtensionsAreRefusedBeforeAnyFile) {
     EXPECT_THROW(checkMeshScale({MeshUnit::Inch, 40000}), ParamError);  // 1016 m
     EXPECT_NO_THROW(checkMeshScale({MeshUnit::Meter, 1000}));
     EXPECT_NO_THROW(checkMeshScale({MeshUnit::Millimeter, 0.01}));
-    EXPECT_NO_THROW(checkMeshScale({MeshUnit::Millimeter, 0}));  // no size
+    EXPECT_NO_THROW(checkMeshScale({MeshUnit::Millimeter, std::nullopt}));  // no size
     try {
         checkMeshScale({MeshUnit::Centimeter, -5});
         ADD_FAILURE();

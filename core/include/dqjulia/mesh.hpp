@@ -18,6 +18,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -58,13 +59,13 @@ DQJ_API Mesh bakeMesh(const Params& params, const BakeOptions& options = {}, con
 /// The length unit of a mesh file's coordinates (`dqjulia mesh --units`).
 enum class MeshUnit { Millimeter, Centimeter, Meter, Inch };
 
-/// A mesh file's physical size: `size` > 0 scales the mesh uniformly so that its largest side is
+/// A mesh file's physical size: a `size` scales the mesh uniformly so that its largest side is
 /// `size` units long and moves it into the positive octant (least corner at 0, as printers
-/// expect); 0 writes slice coordinates as they are. `unit` is the 3MF's unit attribute (the other
-/// formats carry no unit). Sizes above 0 up to kMaxMeshSize (metres: 1 km) are accepted.
+/// expect); none writes slice coordinates as they are. `unit` is the 3MF's unit attribute (the
+/// other formats carry no unit). Sizes above 0 up to kMaxMeshSizeMetres (1 km) are accepted.
 struct MeshScale {
     MeshUnit unit = MeshUnit::Millimeter;
-    double size = 0.0;
+    std::optional<double> size;
 };
 
 /// The unit's name in flags and docs ("mm", "cm", "m", "in") and its length in metres.
@@ -72,7 +73,7 @@ DQJ_API const char* meshUnitName(MeshUnit unit);
 DQJ_API double meshUnitMetres(MeshUnit unit);
 /// The largest MeshScale::size, in metres (1 km: no print and no scene is larger).
 constexpr double kMaxMeshSizeMetres = 1000.0;
-/// Throws ParamError ("mesh.size") unless `scale.size` is 0 or a number above 0 no larger than
+/// Throws ParamError ("mesh.size") unless `scale.size` is none or a number above 0 no larger than
 /// kMaxMeshSizeMetres in its unit.
 DQJ_API void checkMeshScale(const MeshScale& scale);
 

@@ -61,7 +61,7 @@ public:
         std::ostream& triangles = triangles_.stream();
         auto triangle = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
             const int size =
-                colors_ ? std::snprintf(line, sizeof line, "<triangle v1=\"%u\" v2=\"%u\" v3=\"%u\" p1=\"%u\" p2=\"%u\" p3=\"%u\"/>\n",
+                colors_ ? std::snprintf(line, sizeof line, "<triangle v1=\"%u\" v2=\"%u\" v3=\"%u\" pid=\"1\" p1=\"%u\" p2=\"%u\" p3=\"%u\"/>\n",
                                         a, b, c, a, b, c)
                         : std::snprintf(line, sizeof line, "<triangle v1=\"%u\" v2=\"%u\" v3=\"%u\"/>\n", a, b, c);
             triangles.write(line, size);

@@ -4,7 +4,8 @@
 // whose <model> (core specification 1.3, unit from MeshScale) holds one object's mesh - vertices,
 // then triangles (quads split along their 0-2 diagonal, as Mesh::triangulated does) - and, with
 // colours, a Materials extension <m:colorgroup> of one sRGB colour per vertex, which each triangle
-// names per corner (p1 p2 p3: the colour's number is the vertex's). Resources must come before
+// names per corner (pid, then p1 p2 p3: the colour's number is the vertex's; the object's pid would
+// do by the specification, but lib3mf reads p1-p3 only beside a pid). Resources must come before
 // what names them, so the colours, the vertices and the triangles each go to a ScratchFile beside
 // the target as the parts come, as XML text, and the package is made at the end: the model deflated
 // from the three in turn (ZipWriter, files/zip_file.hpp; ZIP64 when the model passes 4 GB).

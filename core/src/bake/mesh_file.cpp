@@ -284,11 +284,12 @@ double meshUnitMetres(MeshUnit unit) {
 
 void checkMeshScale(const MeshScale& scale) {
     const double limit = kMaxMeshSizeMetres / meshUnitMetres(scale.unit);
-    if (scale.size == 0.0) return;  // no size: slice coordinates
-    if (!(scale.size > 0.0) || !(scale.size <= limit)) {  // NaN fails both
+    if (!scale.size) return;  // no size: slice coordinates
+    const double size = *scale.size;
+    if (!(size > 0.0) || !(size <= limit)) {  // NaN fails both
         char text[200];
         std::snprintf(text, sizeof text,
-                      "the size (%g %s) must be above 0 and at most %g %s (1 km): the mesh's largest side", scale.size,
+                      "the size (%g %s) must be above 0 and at most %g %s (1 km): the mesh's largest side", size,
                       meshUnitName(scale.unit), limit, meshUnitName(scale.unit));
         throw ParamError("mesh.size", text);
     }
@@ -303,7 +304,7 @@ void checkMeshPath(const std::string& path) {
 MeshFile::MeshFile(const std::string& path, bool colors, Existing existing, const MeshScale& scale)
     : colors_((checkMeshPath(path), checkMeshScale(scale), colors)), scale_(scale), file_(path, existing),
       format_(makeFormat(file_, colors, scale.unit)) {
-    if (scale_.size > 0.0) parts_ = std::make_unique<ScratchFile>(path);
+    if (scale_.size) parts_ = std::make_unique<ScratchFile>(path);
     least_ = glm::dvec3(std::numeric_limits<double>::infinity());
     most_ = -least_;
 }
@@ -351,12 +352,12 @@ void MeshFile::write(const Mesh& part) {
 
 void MeshFile::commit() {
     if (parts_) {
-        // The mesh's largest side becomes scale_.size; its least corner the origin.
+        // The mesh's largest side becomes the size; its least corner the origin.
         const glm::dvec3 sides = most_ - least_;
         const double largest = std::max({sides.x, sides.y, sides.z});
         if (largest > 0.0) {
             origin_ = least_;
-            factor_ = scale_.size / largest;
+            factor_ = *scale_.size / largest;
         }
         std::vector<char> pending;  // the bytes of the part being read back
         parts_->readBack([&](const char* data, std::size_t size) {
