@@ -203,10 +203,12 @@ std::optional<FrameRange> BakeFlags::frameRange() const {
 MeshScale BakeFlags::meshScale() const {
     MeshScale scale;
     if (!units.empty()) {
-        static const std::pair<const char*, MeshUnit> kUnits[] = {
-            {"mm", MeshUnit::Millimeter}, {"cm", MeshUnit::Centimeter}, {"m", MeshUnit::Meter}, {"in", MeshUnit::Inch}};
-        const auto known = std::find_if(std::begin(kUnits), std::end(kUnits),
-                                        [&](const auto& unit) { return units == unit.first; });
+        static const std::pair<const char*, MeshUnit> kUnits[] = {{"mm", MeshUnit::Millimeter},
+                                                                  {"cm", MeshUnit::Centimeter},
+                                                                  {"m", MeshUnit::Meter},
+                                                                  {"in", MeshUnit::Inch}};
+        const auto known =
+            std::find_if(std::begin(kUnits), std::end(kUnits), [&](const auto& unit) { return units == unit.first; });
         if (known == std::end(kUnits))
             throw ParamError("mesh.units", "--units \"" + inputExcerpt(units) + "\": expected mm, cm, m or in");
         scale.unit = known->second;

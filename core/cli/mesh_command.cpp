@@ -90,7 +90,8 @@ int runMesh(const BakeFlags& flags) {
 
 Runner addMeshCommand(CLI::App& app) {
     auto flags = std::make_shared<BakeFlags>();
-    CLI::App* command = app.add_subcommand("mesh", "Mesh the baked surface into a PLY, OBJ, STL or 3MF file (docs: Baking)");
+    CLI::App* command =
+        app.add_subcommand("mesh", "Mesh the baked surface into a PLY, OBJ, STL or 3MF file (docs: Baking)");
     flags->addTo(*command, BakeCommand::Mesh);
     return [flags] { return reportErrors("mesh", [&] { return runMesh(*flags); }); };
 }

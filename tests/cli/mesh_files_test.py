@@ -61,8 +61,10 @@ def check_closed(failures, label, loaded, triangles):
     if open_edges or repeated:
         failures.append("%s: %d edges not in two triangles, %d directed edges repeated" % (label, open_edges, repeated))
     if not (loaded.is_watertight and loaded.is_winding_consistent):
-        failures.append("%s: trimesh: watertight %s, winding consistent %s"
-                        % (label, loaded.is_watertight, loaded.is_winding_consistent))
+        failures.append(
+            "%s: trimesh: watertight %s, winding consistent %s"
+            % (label, loaded.is_watertight, loaded.is_winding_consistent)
+        )
 
 
 def read_3mf(path):
@@ -95,9 +97,10 @@ def check_3mf(failures, label, path, ply_path, stats, unit):
         return
     mesh = meshes[0]
     if (mesh.GetVertexCount(), mesh.GetTriangleCount()) != (stats["vertices"], stats["triangulated"]):
-        failures.append("%s: lib3mf counts %d vertices, %d triangles; --stats %d, %d"
-                        % (label, mesh.GetVertexCount(), mesh.GetTriangleCount(), stats["vertices"],
-                           stats["triangulated"]))
+        failures.append(
+            "%s: lib3mf counts %d vertices, %d triangles; --stats %d, %d"
+            % (label, mesh.GetVertexCount(), mesh.GetTriangleCount(), stats["vertices"], stats["triangulated"])
+        )
     if not mesh.IsManifoldAndOriented():
         failures.append("%s: lib3mf: not manifold and oriented" % label)
     # Every corner's colour is the PLY's colour of that vertex (the same vertex order).
@@ -111,8 +114,10 @@ def check_3mf(failures, label, path, ply_path, stats, unit):
             if colors.get((property.ResourceID, property_id)) != tuple(ply_colors[vertex]):
                 wrong += 1
     if len(colors) != stats["vertices"] or wrong:
-        failures.append("%s: %d colours for %d vertices, %d corners with another colour than the PLY's"
-                        % (label, len(colors), stats["vertices"], wrong))
+        failures.append(
+            "%s: %d colours for %d vertices, %d corners with another colour than the PLY's"
+            % (label, len(colors), stats["vertices"], wrong)
+        )
 
 
 def check_shapes(cli, work, failures):
@@ -129,13 +134,17 @@ def check_shapes(cli, work, failures):
                 radii = numpy.linalg.norm(loaded.vertices, axis=1)
                 sphere = 4 / 3 * numpy.pi * radii.mean() ** 3
                 if abs(radii - 1).max() > 3 / 48 or abs(loaded.volume / sphere - 1) > 0.01:
-                    failures.append("%s: radii %.4f to %.4f, volume %.4f (a sphere of the mean radius: %.4f)"
-                                    % (label, radii.min(), radii.max(), loaded.volume, sphere))
+                    failures.append(
+                        "%s: radii %.4f to %.4f, volume %.4f (a sphere of the mean radius: %.4f)"
+                        % (label, radii.min(), radii.max(), loaded.volume, sphere)
+                    )
             if extension == "3mf":
                 check_3mf(failures, label, path, os.path.join(work, shape + ".ply"), stats, "mm")
         for extension, box in bounds.items():
             if not numpy.allclose(box, bounds["ply"], atol=1e-5):
-                failures.append("%s.%s: bounds %s, the PLY's %s" % (shape, extension, box.tolist(), bounds["ply"].tolist()))
+                failures.append(
+                    "%s.%s: bounds %s, the PLY's %s" % (shape, extension, box.tolist(), bounds["ply"].tolist())
+                )
 
 
 def check_sizes(cli, work, failures):
@@ -148,7 +157,9 @@ def check_sizes(cli, work, failures):
             check_closed(failures, label, loaded, stats["triangulated"])
             low, high = loaded.bounds
             if not (numpy.allclose(low, 0, atol=1e-6 * size) and abs(high.max() - size) <= 1e-5 * size):
-                failures.append("%s: bounds %s, expected 0 to a largest side of %g" % (label, loaded.bounds.tolist(), size))
+                failures.append(
+                    "%s: bounds %s, expected 0 to a largest side of %g" % (label, loaded.bounds.tolist(), size)
+                )
             if extension == "3mf":
                 check_3mf(failures, label, path, os.path.join(work, "sized-%s.ply" % unit), stats, unit)
 
@@ -172,8 +183,10 @@ def check_refusals(cli, work, failures):
         for arguments, message in cases:
             done = run(cli, "-r", "16", *arguments, "-o", os.path.join(folder, "m." + extension))
             if done.returncode != 2 or message not in done.stderr:
-                failures.append("%s .%s: exit %d, %r (expected 2 and %r)"
-                                % (" ".join(arguments), extension, done.returncode, done.stderr.strip(), message))
+                failures.append(
+                    "%s .%s: exit %d, %r (expected 2 and %r)"
+                    % (" ".join(arguments), extension, done.returncode, done.stderr.strip(), message)
+                )
     if os.listdir(folder):
         failures.append("refused runs left %s" % os.listdir(folder))
 
@@ -189,8 +202,10 @@ def main():
     if failures:
         print("\n".join(failures))
         sys.exit(1)
-    print("every format closed, edge-manifold and oriented; 3MF read by lib3mf %s with its colours; sizes and refusals"
-          % ".".join(map(str, lib3mf.get_wrapper().GetLibraryVersion())))
+    print(
+        "every format closed, edge-manifold and oriented; 3MF read by lib3mf %s with its colours; sizes and refusals"
+        % ".".join(map(str, lib3mf.get_wrapper().GetLibraryVersion()))
+    )
 
 
 if __name__ == "__main__":

@@ -16,6 +16,7 @@
 #include "bake/mesh_file.hpp"
 #include "bake/mesh_stream.hpp"
 #include "bake_fixture.hpp"
+#include "files/zip_file.hpp"
 #include "dqjulia/mesh.hpp"
 #include "test_support.hpp"
 
@@ -100,7 +101,8 @@ TEST_F(MeshFormats, StreamedStlEqualsTheMeshInOnePiece) {
     for (const int slab : {8, 16}) {
         MeshFile file(path("slabs.stl"), false, Existing::Replace);
         BakeStats stats;
-        meshSurface(params, {}, {}, [&file](Mesh&& part) { file.add(part); }, stats, slab);
+        meshSurface(
+            params, {}, {}, [&file](Mesh&& part) { file.add(part); }, stats, slab);
         file.commit();
         EXPECT_GE(stats.slabs, 96u / slab - 1) << slab;
         EXPECT_EQ(triangleKeys(readStl(path("slabs.stl"))), triangleKeys(readStl(path("whole.stl")))) << slab;
@@ -132,7 +134,8 @@ TEST_F(MeshFormats, SizeScalesTheLargestSideAndMovesTheMeshIntoThePositiveOctant
         // The same scale streamed: parts set aside until the bounds are known.
         MeshFile file(path("slabs.stl"), false, Existing::Replace, MeshScale{unit, size});
         BakeStats stats;
-        meshSurface(defaultAt(48), {}, {}, [&file](Mesh&& part) { file.add(part); }, stats, 8);
+        meshSurface(
+            defaultAt(48), {}, {}, [&file](Mesh&& part) { file.add(part); }, stats, 8);
         file.commit();
         EXPECT_EQ(triangleKeys(readStl(path("slabs.stl"))), triangleKeys(triangles));
     }
@@ -159,10 +162,42 @@ TEST_F(MeshFormats, NonsenseSizesAndExtensionsAreRefusedBeforeAnyFile) {
                   std::string::npos)
             << error.what();
     }
-    for (const char* name : {"m.stlx", "m.3mf.txt", "m", "m.amf"}) EXPECT_THROW(writeMesh(mesh, path(name)), ParamError);
+    for (const char* name : {"m.stlx", "m.3mf.txt", "m", "m.amf"})
+        EXPECT_THROW(writeMesh(mesh, path(name)), ParamError);
     EXPECT_NO_THROW(writeMesh(mesh, path("M.STL")));
     EXPECT_NO_THROW(writeMesh(mesh, path("M.3MF")));
     EXPECT_EQ(files(), (std::vector<std::string>{"M.3MF", "M.STL"}));
+}
+
+}  // namespace
+
+namespace {
+
+// ZIP64 (a 3MF's model past 4 GB): an entry of 4.3 GB of zeros (a few MB deflated) and an entry
+// after it, whose offset passes 4 GB too, read back by Python's zipfile, which checks every CRC.
+TEST_F(MeshFormats, ZipEntriesAndOffsetsPast4GbAreZip64) {
+    {
+        AtomicFile file(path("big.zip"));
+        ZipWriter zip(file);
+        zip.begin("big.bin");
+        const std::vector<char> zeros(std::size_t(1) << 24, 0);
+        const std::uint64_t size = (std::uint64_t(1) << 32) + (std::uint64_t(1) << 28);  // 4.25 GiB
+        for (std::uint64_t written = 0; written < size; written += zeros.size()) zip.write(zeros.data(), zeros.size());
+        zip.write("end");
+        zip.begin("after.txt");
+        zip.write("after 4 GB");
+        zip.finish();
+        file.commit();
+    }
+    const auto read = dqj::test::runCommand(
+        "/usr/bin/python3",
+        "-c \"import sys, zipfile; z = zipfile.ZipFile(sys.argv[1]); assert z.testzip() is None; "
+        "print([(i.filename, i.file_size) for i in z.infolist()], z.read('after.txt').decode())\" '" +
+            path("big.zip") + "'",
+        dir_);
+    ASSERT_EQ(read.exitCode, 0) << read.err;
+    EXPECT_NE(read.out.find("[('big.bin', 4563402755), ('after.txt', 10)] after 4 GB"), std::string::npos)
+        << read.out;
 }
 
 }  // namespace

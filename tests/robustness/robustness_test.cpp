@@ -93,8 +93,8 @@ class InterruptMesh : public Scratch, public ::testing::WithParamInterface<MeshI
 TEST_P(InterruptMesh, AtAnySlabLeavesNothingAndKeepsThePreviousMesh) {
     const fs::path output = dir_ / (std::string("mesh") + GetParam().extension);
     std::ofstream(output) << "previous mesh";
-    std::vector<std::string> arguments{"mesh", "-q", "--force", "-r", "1024", "--max-memory", "400M", "-o",
-                                       output.string()};
+    std::vector<std::string> arguments{"mesh",         "-q",   "--force", "-r",           "1024",
+                                       "--max-memory", "400M", "-o",      output.string()};
     if (GetParam().sized) arguments.insert(arguments.end(), {"--units", "mm", "--size", "100"});
     const pid_t pid = dqj::test::spawnProgram(DQJ_CLI, arguments, dir_ / "stderr.txt");
     ASSERT_GT(pid, 0);

@@ -45,7 +45,8 @@ public:
         char line[192];
         std::ostream& vertices = vertices_.stream();
         for (const glm::vec3& p : part.positions) {
-            const int size = std::snprintf(line, sizeof line, "<vertex x=\"%.7g\" y=\"%.7g\" z=\"%.7g\"/>\n", p.x, p.y, p.z);
+            const int size =
+                std::snprintf(line, sizeof line, "<vertex x=\"%.7g\" y=\"%.7g\" z=\"%.7g\"/>\n", p.x, p.y, p.z);
             vertices.write(line, size);
         }
         if (colors_) {
@@ -61,8 +62,10 @@ public:
         std::ostream& triangles = triangles_.stream();
         auto triangle = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
             const int size =
-                colors_ ? std::snprintf(line, sizeof line, "<triangle v1=\"%u\" v2=\"%u\" v3=\"%u\" pid=\"1\" p1=\"%u\" p2=\"%u\" p3=\"%u\"/>\n",
-                                        a, b, c, a, b, c)
+                colors_ ? std::snprintf(
+                              line, sizeof line,
+                              "<triangle v1=\"%u\" v2=\"%u\" v3=\"%u\" pid=\"1\" p1=\"%u\" p2=\"%u\" p3=\"%u\"/>\n", a,
+                              b, c, a, b, c)
                         : std::snprintf(line, sizeof line, "<triangle v1=\"%u\" v2=\"%u\" v3=\"%u\"/>\n", a, b, c);
             triangles.write(line, size);
         };
@@ -99,7 +102,8 @@ public:
         copy(vertices_);
         zip.write("</vertices>\n<triangles>\n");
         copy(triangles_);
-        zip.write("</triangles>\n</mesh>\n</object>\n</resources>\n<build>\n<item objectid=\"2\"/>\n</build>\n</model>\n");
+        zip.write(
+            "</triangles>\n</mesh>\n</object>\n</resources>\n<build>\n<item objectid=\"2\"/>\n</build>\n</model>\n");
         zip.finish();
     }
 

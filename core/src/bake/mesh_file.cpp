@@ -170,8 +170,9 @@ public:
         triangles_ += part.triangleCount();
         if (triangles_ > UINT32_MAX)
             throw std::runtime_error(AtomicFile::failureMessage(
-                file_.path(), "the mesh has more than 2^32 - 1 triangles, more than a binary STL can hold: lower "
-                              "the resolution or write a .ply or .3mf"));
+                file_.path(),
+                "the mesh has more than 2^32 - 1 triangles, more than a binary STL can hold: lower "
+                "the resolution or write a .ply or .3mf"));
         const auto position = [&](std::uint32_t vertex) -> const glm::vec3& {
             if (vertex >= firstVertex) return part.positions[vertex - firstVertex];
             if (vertex >= previousFirst_ && vertex - previousFirst_ < previous_.size())
@@ -234,7 +235,9 @@ void writeRawPart(std::ostream& out, const Mesh& part) {
                                bytes(part.triangles) + bytes(part.quads);
     out.write(reinterpret_cast<const char*>(&size), sizeof size);
     out.write(reinterpret_cast<const char*>(counts), sizeof counts);
-    auto put = [&](const auto& values) { out.write(reinterpret_cast<const char*>(values.data()), std::streamsize(bytes(values))); };
+    auto put = [&](const auto& values) {
+        out.write(reinterpret_cast<const char*>(values.data()), std::streamsize(bytes(values)));
+    };
     put(part.positions);
     put(part.normals);
     put(part.colors);
@@ -302,7 +305,9 @@ void checkMeshPath(const std::string& path) {
 }
 
 MeshFile::MeshFile(const std::string& path, bool colors, Existing existing, const MeshScale& scale)
-    : colors_((checkMeshPath(path), checkMeshScale(scale), colors)), scale_(scale), file_(path, existing),
+    : colors_((checkMeshPath(path), checkMeshScale(scale), colors)),
+      scale_(scale),
+      file_(path, existing),
       format_(makeFormat(file_, colors, scale.unit)) {
     if (scale_.size) parts_ = std::make_unique<ScratchFile>(path);
     least_ = glm::dvec3(std::numeric_limits<double>::infinity());

@@ -51,7 +51,7 @@ private:
     struct Deflater;
     std::unique_ptr<Deflater> deflater_;
     std::vector<Entry> entries_;
-    bool open_ = false;  // an entry is being written
+    bool open_ = false;         // an entry is being written
     std::uint64_t offset_ = 0;  // bytes of the archive so far
 };
 
