@@ -196,8 +196,7 @@ TEST_F(MeshFormats, ZipEntriesAndOffsetsPast4GbAreZip64) {
             path("big.zip") + "'",
         dir_);
     ASSERT_EQ(read.exitCode, 0) << read.err;
-    EXPECT_NE(read.out.find("[('big.bin', 4563402755), ('after.txt', 10)] after 4 GB"), std::string::npos)
-        << read.out;
+    EXPECT_NE(read.out.find("[('big.bin', 4563402755), ('after.txt', 10)] after 4 GB"), std::string::npos) << read.out;
 }
 
 }  // namespace
