@@ -23,7 +23,7 @@ if [ "$(id -u)" -ne 0 ]; then
 fi
 background_log="$(mktemp)"
 trap 'rm -f "$background_log"' EXIT
-("$tests_packages" && scripts/bpy-env.sh && scripts/tool-env.sh ruff && scripts/tool-env.sh mypy && scripts/tool-env.sh openjd && scripts/tool-env.sh twine && scripts/tool-env.sh auditwheel && scripts/tool-env.sh sphinx) >"$background_log" 2>&1 &
+("$tests_packages" && scripts/bpy-env.sh && scripts/tool-env.sh ruff && scripts/tool-env.sh mypy && scripts/tool-env.sh openjd && scripts/tool-env.sh twine && scripts/tool-env.sh auditwheel && scripts/tool-env.sh sphinx && scripts/tool-env.sh meshcheck) >"$background_log" 2>&1 &
 background=$!
 scripts/build-deps.sh >/dev/null
 scripts/build.sh

@@ -10,6 +10,10 @@
 #   sphinx      the documentation site's builder (docs/, tests/docs, scripts/release.sh): Sphinx with
 #               MyST-Parser for the Markdown pages and the Furo theme, pinned together (about 60 MB);
 #               its program is sphinx-build
+#   meshcheck   the independent readers of the mesh tests (tests/core/mesh_files_test.py): trimesh
+#               (watertight and edge-manifold checks of every mesh format) with lxml and networkx for
+#               its 3MF loader, and lib3mf, the 3MF consortium's library, through its Python binding
+#               (about 120 MB); its program is python
 #
 #   scripts/tool-env.sh TOOL           make the venv if it is missing (an existing one costs nothing)
 #   scripts/tool-env.sh TOOL --print   print the tool's program (installs nothing; exit 1 if absent)
@@ -19,7 +23,7 @@
 # `TOOL --version` fails is made again.
 set -euo pipefail
 
-usage() { echo "usage: tool-env.sh ruff|mypy|openjd|auditwheel|twine|sphinx [--print]" >&2; exit 2; }
+usage() { echo "usage: tool-env.sh ruff|mypy|openjd|auditwheel|twine|sphinx|meshcheck [--print]" >&2; exit 2; }
 [ $# -ge 1 ] || usage
 tool="$1"
 shift
@@ -32,6 +36,9 @@ case "$tool" in
   # One venv of three pinned packages: the folder's name carries every pin.
   sphinx) version=9.0.4-myst5.0.0-furo2025.12.19 program_name=sphinx-build
           package="sphinx==9.0.4 myst-parser==5.0.0 furo==2025.12.19" cache="${DQJ_SPHINX_CACHE:-}" ;;
+  meshcheck) version=trimesh5.2.0-lib3mf2.5.0 program_name=python
+             package="trimesh==5.2.0 numpy==2.4.6 lxml==6.1.3 networkx==3.6.1 lib3mf==2.5.0"
+             cache="${DQJ_MESHCHECK_CACHE:-}" ;;
   *) usage ;;
 esac
 cache="${cache:-${XDG_CACHE_HOME:-$HOME/.cache}/dqjulia/$tool}"

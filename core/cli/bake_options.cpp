@@ -5,6 +5,7 @@
 #include "files/message_text.hpp"
 #include "schema_options.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -60,7 +61,8 @@ void BakeFlags::addTo(CLI::App& command, BakeCommand kind) {
     fractal.addTo(command);
     command
         .add_option("-o,--output", output,
-                    mesh                        ? "Output mesh: .ply (binary) or .obj"
+                    mesh                        ? "Output mesh: .ply (binary), .obj, .stl (binary; no colours) or .3mf "
+                                                  "(vertex colours)"
                     : kind == BakeCommand::Farm ? "The bake's output file (.vdb), on storage every machine shares"
                                                 : "Output OpenVDB file (.vdb)")
         ->required();
@@ -70,6 +72,12 @@ void BakeFlags::addTo(CLI::App& command, BakeCommand kind) {
     if (mesh) {
         schemaOption(command, "--adaptivity", "bake.adaptivity", adaptivity);
         schemaOffFlag(command, "--no-colors", "bake.mesh_colors", noColors);
+        command.add_option("--units", units,
+                           "The mesh's length unit: mm, cm, m or in; the unit of --size, and a .3mf's unit "
+                           "(default mm). Without --size the coordinates are the slice's, whatever the unit");
+        command.add_option("--size", size,
+                           "Scale the mesh so that its largest side is SIZE --units long (needs --units), its least "
+                           "corner at 0 (for printing; up to 1 km); every format");
     } else {
         schemaOption(command, "--grids", "bake.grids", grids);
         schemaOption(command, "--band-width", "bake.band_width", bandWidth);
@@ -190,6 +198,36 @@ std::optional<FrameRange> BakeFlags::frameRange() const {
         throw ParamError("frames", "--frames \"" + inputExcerpt(frames) +
                                        "\": the last frame comes before the first; write FIRST-LAST, e.g. 1-48");
     return range;
+}
+
+MeshScale BakeFlags::meshScale() const {
+    MeshScale scale;
+    if (!units.empty()) {
+        static const std::pair<const char*, MeshUnit> kUnits[] = {{"mm", MeshUnit::Millimeter},
+                                                                  {"cm", MeshUnit::Centimeter},
+                                                                  {"m", MeshUnit::Meter},
+                                                                  {"in", MeshUnit::Inch}};
+        const auto known =
+            std::find_if(std::begin(kUnits), std::end(kUnits), [&](const auto& unit) { return units == unit.first; });
+        if (known == std::end(kUnits))
+            throw ParamError("mesh.units", "--units \"" + inputExcerpt(units) + "\": expected mm, cm, m or in");
+        scale.unit = known->second;
+    }
+    if (!size) return scale;
+    const std::string& text = *size;
+    if (units.empty())
+        throw ParamError("mesh.size", "--size " + inputExcerpt(text) +
+                                          " needs --units (mm, cm, m or in): a print's size means nothing without one");
+    std::size_t used = 0;
+    try {
+        scale.size = std::stod(text, &used);  // nan and inf too: checkMeshScale refuses them
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used == 0 || used != text.size())
+        throw ParamError("mesh.size", "--size \"" + inputExcerpt(text) + "\": expected a number, e.g. 120");
+    checkMeshScale(scale);
+    return scale;
 }
 
 std::uint64_t BakeFlags::memoryLimit() const {

@@ -11,6 +11,7 @@
 
 #include "common.hpp"
 #include "dqjulia/bake.hpp"
+#include "dqjulia/mesh.hpp"
 #include "dqjulia/params.hpp"
 #include "dqjulia/tiles.hpp"
 
@@ -37,6 +38,8 @@ struct BakeFlags {
     std::string maxMemory;
     std::optional<double> adaptivity;  // mesh only
     bool noColors = false;             // mesh only
+    std::string units;                 // mesh only: --units (meshScale)
+    std::optional<std::string> size;   // mesh only: --size, as given (meshScale)
     std::string tiles;                 // bake and farm
     std::optional<int> tile;           // bake only
     std::optional<int> threads;        // bake and mesh
@@ -53,6 +56,9 @@ struct BakeFlags {
     Params load() const;
     /// --frames, if given. Throws ParamError for a malformed or reversed range.
     std::optional<FrameRange> frameRange() const;
+    /// --units and --size. Throws ParamError for an unknown unit, a size that is not a number or
+    /// out of range (checkMeshScale), and --size without --units.
+    MeshScale meshScale() const;
     /// --max-memory in bytes, or 0 for the default. Throws ParamError.
     std::uint64_t memoryLimit() const;
     /// --tiles (its index --tile, or 0 for every tile), if given. Throws ParamError.

@@ -1,4 +1,4 @@
-// dqjulia mesh: the baked surface as a PLY or OBJ mesh (normals, vertex colours), one file or,
+// dqjulia mesh: the baked surface as a PLY, OBJ, STL or 3MF mesh, one file or,
 // with --frames, one file per frame of an animation.
 #include <iomanip>
 #include <iostream>
@@ -17,10 +17,8 @@ namespace {
 
 int runMesh(const BakeFlags& flags) {
     const Params params = flags.load();
-    std::string extension = flags.output.size() >= 4 ? flags.output.substr(flags.output.size() - 4) : "";
-    for (char& ch : extension) ch = char(std::tolower(static_cast<unsigned char>(ch)));
-    if (extension != ".ply" && extension != ".obj")
-        throw ParamError("output.path", "--output '" + inputExcerpt(flags.output) + "' must end in .ply or .obj");
+    checkMeshPath(flags.output);
+    const MeshScale scale = flags.meshScale();
     const std::uint64_t memoryLimit = flags.memoryLimit();
 
     flags.checkExistingFlags();
@@ -56,7 +54,7 @@ int runMesh(const BakeFlags& flags) {
             try {
                 // Written as it is made, slab by slab where the memory limit asks for it; the file
                 // appears only complete (a signal in the last moments, too, leaves nothing).
-                mesh = bakeMeshFile(perFrame[index], paths[index], options, bakeProgress(bar, monitor), &stats);
+                mesh = bakeMeshFile(perFrame[index], paths[index], options, bakeProgress(bar, monitor), &stats, scale);
             } catch (const Cancelled&) {
                 bar.finish();
                 if (index == 0) throw;
@@ -92,7 +90,8 @@ int runMesh(const BakeFlags& flags) {
 
 Runner addMeshCommand(CLI::App& app) {
     auto flags = std::make_shared<BakeFlags>();
-    CLI::App* command = app.add_subcommand("mesh", "Mesh the baked surface into a PLY or OBJ file (docs: Baking)");
+    CLI::App* command =
+        app.add_subcommand("mesh", "Mesh the baked surface into a PLY, OBJ, STL or 3MF file (docs: Baking)");
     flags->addTo(*command, BakeCommand::Mesh);
     return [flags] { return reportErrors("mesh", [&] { return runMesh(*flags); }); };
 }

@@ -386,8 +386,9 @@ class Fractal:
         progress: ProgressCallback | None = None,
         cancel: threading.Event | None = None,
     ) -> BakeStats:
-        """Meshes the surface and writes it: .ply (binary, with normals and colours) or .obj, the
-        file `dqjulia mesh` writes. Returns what it cost."""
+        """Meshes the surface and writes it, by the path's extension: .ply (binary, with normals and
+        colours), .obj, .stl (binary, no colours) or .3mf (vertex colours), the file `dqjulia mesh`
+        writes (in slice coordinates). Returns what it cost."""
         stats = self._bake_work(resolution, self._context.mesh_compute, progress, cancel)
         self._context.mesh_write(os.fspath(path))
         return stats

@@ -106,9 +106,9 @@ TEST_F(BakeCli, BadInputGetsOneClearMessageAndWritesNothing) {
     const Outcome png = run("bake -o '" + path("x.png") + "'");
     EXPECT_EQ(png.exitCode, 2);
     EXPECT_NE(png.err.find("must end in .vdb"), std::string::npos) << png.err;
-    const Outcome stl = run("mesh -o '" + path("x.stl") + "'");
-    EXPECT_EQ(stl.exitCode, 2);
-    EXPECT_NE(stl.err.find("must end in .ply or .obj"), std::string::npos) << stl.err;
+    const Outcome amf = run("mesh -o '" + path("x.amf") + "'");
+    EXPECT_EQ(amf.exitCode, 2);
+    EXPECT_NE(amf.err.find("must end in .ply, .obj, .stl or .3mf"), std::string::npos) << amf.err;
     const Outcome folder = run("bake -o '" + path("missing/x.vdb") + "'");
     EXPECT_EQ(folder.exitCode, 2);
     EXPECT_NE(folder.err.find("does not exist"), std::string::npos) << folder.err;

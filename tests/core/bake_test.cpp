@@ -284,7 +284,7 @@ TEST_F(Bake, MeshFilesHoldTheMesh) {
     const Mesh mesh = bakeMesh(params);
     writeMesh(mesh, path("m.ply"));
     writeMesh(mesh, path("m.obj"));
-    EXPECT_THROW(writeMesh(mesh, path("m.stl")), ParamError);
+    EXPECT_THROW(writeMesh(mesh, path("m.amf")), ParamError);
     EXPECT_EQ(files(), (std::vector<std::string>{"m.obj", "m.ply"}));
     std::ifstream ply(path("m.ply"), std::ios::binary);
     std::string line, header;

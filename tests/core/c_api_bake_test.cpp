@@ -92,7 +92,12 @@ TEST_F(BakeCApi, MeshIntoCallerBuffers) {
     EXPECT_EQ(vertexOnly, positions);
     ASSERT_EQ(dqj_mesh_write(context_, path("c.ply").c_str()), DQJ_OK);
     EXPECT_TRUE(fs::exists(path("c.ply")));
-    EXPECT_EQ(dqj_mesh_write(context_, path("c.stl").c_str()), DQJ_ERROR_PARAMETERS);
+    // STL and 3MF by the extension (tests/core/mesh_formats_test.cpp and mesh_files_test.py read them).
+    ASSERT_EQ(dqj_mesh_write(context_, path("c.stl").c_str()), DQJ_OK);
+    EXPECT_EQ(fs::file_size(path("c.stl")), 84 + 50 * triangles);
+    ASSERT_EQ(dqj_mesh_write(context_, path("c.3mf").c_str()), DQJ_OK);
+    EXPECT_EQ(dqj::test::readFile(path("c.3mf")).substr(0, 4), std::string("PK\x03\x04", 4));
+    EXPECT_EQ(dqj_mesh_write(context_, path("c.amf").c_str()), DQJ_ERROR_PARAMETERS);
     EXPECT_EQ(dqj_mesh_copy(nullptr, positions.data(), nullptr, nullptr, vertices, indices.data(), triangles),
               DQJ_ERROR_INVALID_HANDLE);
 }

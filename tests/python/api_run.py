@@ -5,7 +5,7 @@ compare with the build's command (it needs nothing but the package and NumPy).
 Usage: python api_run.py PARAMS EMPTY_PARAMS POINTS8 POINTS3 WORK   (EMPTY_PARAMS: a file whose slice is empty)
 
 Writes into WORK: api.png (render_to_file), api_render.rgba (render(): the array's bytes),
-api.vdb (bake), api.ply (mesh_to_file), api_mesh_*.bin (mesh(): each array's bytes), and
+api.vdb (bake), api.ply, api.stl and api.3mf (mesh_to_file), api_mesh_*.bin (mesh(): each array's bytes), and
 api.json: the shapes, the evaluations' values (repr, exact), the bake's stats, and the checks of
 parameters from a dict, JSON text and a file, errors, progress and cancel.
 """
@@ -125,7 +125,8 @@ def main():
         result["mesh_shapes"][name] = [list(array.shape), str(array.dtype)]
         with open(os.path.join(work, "api_mesh_%s.bin" % name), "wb") as file:
             file.write(array.tobytes())
-    fractal.mesh_to_file(os.path.join(work, "api.ply"))
+    for extension in ("ply", "stl", "3mf"):
+        fractal.mesh_to_file(os.path.join(work, "api." + extension))
 
     # An empty slice: the library's warning as a DqjuliaWarning.
     with warnings.catch_warnings(record=True) as caught:

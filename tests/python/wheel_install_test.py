@@ -239,6 +239,8 @@ def main():
             ("png", ["render", "-q", "-p", params, "-o", os.path.join(folder, "out.png")]),
             ("vdb", ["bake", "-p", params, "-o", os.path.join(folder, "out.vdb")]),
             ("ply", ["mesh", "-q", "-p", params, "-o", os.path.join(folder, "out.ply")]),
+            ("stl", ["mesh", "-q", "-p", params, "-o", os.path.join(folder, "out.stl")]),
+            ("3mf", ["mesh", "-q", "-p", params, "-o", os.path.join(folder, "out.3mf")]),
         ):
             status, stdout, stderr = run([program, *arguments])
             made[kind] = stdout + stderr
@@ -309,9 +311,10 @@ def main():
     checks["API: bake()'s active voxels are the command's (%s)" % result["bake_stats"]["active_voxels"]] = (
         active is not None and int(active.group(1)) == result["bake_stats"]["active_voxels"]
     )
-    checks["API: mesh_to_file writes the command's PLY bytes"] = files_equal(
-        os.path.join(api, "api.ply"), os.path.join(reference, "out.ply")
-    )
+    for extension in ("ply", "stl", "3mf"):  # the format by the path's extension
+        checks["API: mesh_to_file writes the command's %s bytes" % extension.upper()] = files_equal(
+            os.path.join(api, "api." + extension), os.path.join(reference, "out." + extension)
+        )
     floats, colors, faces = read_ply(os.path.join(reference, "out.ply"))
     arrays = {}
     for name in ("vertices", "normals", "quads", "triangles"):

@@ -673,6 +673,9 @@ const Writer kWriters[] = {
     {"vdb", "bake -q -r 32 --grids surface,density,color -o OUT/out.vdb", {"out.vdb"}},
     {"ply", "mesh -q -r 32 -o OUT/out.ply", {"out.ply"}},
     {"obj", "mesh -q -r 32 -o OUT/out.obj", {"out.obj"}},
+    {"stl", "mesh -q -r 32 -o OUT/out.stl", {"out.stl"}},
+    {"3mf", "mesh -q -r 32 -o OUT/out.3mf", {"out.3mf"}},
+    {"stl_sized", "mesh -q -r 32 --units mm --size 80 -o OUT/out.stl", {"out.stl"}},
     {"pov", "povray -q -o OUT/out.pov", {"out.pov", "dqjulia.inc"}},
     {"df3", "povray -q --no-include --df3 --df3-resolution 12 -o OUT/out.pov", {"out.pov", "out.df3", "out_df3.pov"}},
 };

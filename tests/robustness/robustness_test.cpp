@@ -80,44 +80,61 @@ TEST_F(Scratch, FullDiskIsReportedAndLeavesNothing) {
 }
 
 // A mesh made in slabs under a small limit (--max-memory), each slab written as it comes: a
-// signal at any slab, early or late, leaves no file and keeps the one there. The mesh takes some
-// 6 s on 2 idle cores (11 slabs), twice the latest signal (512^3 took 2.6 s and was done by then).
-class InterruptMesh : public Scratch, public ::testing::WithParamInterface<int> {};
+// signal at any slab, early or late, leaves no file and keeps the one there, in every format (a
+// 3MF's colours, vertices and triangles set aside, a sized mesh's parts set aside). The mesh takes
+// some 6 s on 2 idle cores (11 slabs), twice the latest signal (512^3 took 2.6 s and was done by then).
+struct MeshInterrupt {
+    int milliseconds;
+    const char* extension;
+    bool sized;  // --units mm --size 100
+};
+class InterruptMesh : public Scratch, public ::testing::WithParamInterface<MeshInterrupt> {};
 
 TEST_P(InterruptMesh, AtAnySlabLeavesNothingAndKeepsThePreviousMesh) {
-    const fs::path output = dir_ / "mesh.ply";
+    const fs::path output = dir_ / (std::string("mesh") + GetParam().extension);
     std::ofstream(output) << "previous mesh";
-    const pid_t pid =
-        dqj::test::spawnProgram(DQJ_CLI,
-                                {"mesh", "-q", "--force", "-r", "1024", "--max-memory", "400M", "-o", output.string()},
-                                dir_ / "stderr.txt");
+    std::vector<std::string> arguments{"mesh",         "-q",   "--force", "-r",           "1024",
+                                       "--max-memory", "400M", "-o",      output.string()};
+    if (GetParam().sized) arguments.insert(arguments.end(), {"--units", "mm", "--size", "100"});
+    const pid_t pid = dqj::test::spawnProgram(DQJ_CLI, arguments, dir_ / "stderr.txt");
     ASSERT_GT(pid, 0);
-    std::this_thread::sleep_for(std::chrono::milliseconds(GetParam()));
+    std::this_thread::sleep_for(std::chrono::milliseconds(GetParam().milliseconds));
     ASSERT_EQ(::kill(pid, SIGINT), 0);
     EXPECT_EQ(waitExit(pid), 130) << readFile(dir_ / "stderr.txt");
     EXPECT_EQ(readFile(output), "previous mesh");
-    EXPECT_EQ(filesIn(dir_).size(), 2u);  // mesh.ply and stderr.txt only: no temporary, no faces set aside
+    EXPECT_EQ(filesIn(dir_).size(), 2u);  // the mesh and stderr.txt only: no temporary, nothing set aside
 }
 
-INSTANTIATE_TEST_SUITE_P(Slabs, InterruptMesh, ::testing::Values(500, 1500, 3000),
-                         [](const auto& info) { return "after" + std::to_string(info.param) + "ms"; });
+INSTANTIATE_TEST_SUITE_P(Slabs, InterruptMesh,
+                         ::testing::Values(MeshInterrupt{500, ".ply", false}, MeshInterrupt{1500, ".ply", false},
+                                           MeshInterrupt{3000, ".ply", false}, MeshInterrupt{1500, ".stl", false},
+                                           MeshInterrupt{3000, ".3mf", false}, MeshInterrupt{3000, ".stl", true}),
+                         [](const auto& info) {
+                             return std::string(info.param.extension + 1) + (info.param.sized ? "_sized" : "") +
+                                    "_after" + std::to_string(info.param.milliseconds) + "ms";
+                         });
 
 TEST_F(Scratch, AFullDiskStopsAStreamedMeshAndLeavesNothing) {
     const dqj::test::Tmpfs tiny(dir_ / "tiny", "1m");
     if (!tiny.mounted()) GTEST_SKIP() << "cannot mount a small tmpfs here (" << std::strerror(errno) << "); needs root";
     const fs::path& disk = tiny.path();
-    std::ofstream(disk / "mesh.ply") << "previous mesh";
-    // Some 6 MB of PLY in slabs: the disk fills part of the way through.
-    const pid_t pid = dqj::test::spawnProgram(DQJ_CLI,
-                                              {"mesh", "-q", "--force", "-r", "192", "--max-memory", "120M", "-o",
-                                               (disk / "mesh.ply").string()},
-                                              dir_ / "stderr.txt");
-    ASSERT_GT(pid, 0);
-    EXPECT_EQ(waitExit(pid), 1);
-    const std::string err = readFile(dir_ / "stderr.txt");
-    EXPECT_NE(err.find("No space left on device"), std::string::npos) << err;
-    EXPECT_EQ(filesIn(disk), std::vector<std::string>{"mesh.ply"});
-    EXPECT_EQ(readFile(disk / "mesh.ply"), "previous mesh");
+    // Some 6 MB of PLY in slabs (STL 14 MB; a 3MF's text set aside, 20 MB): the disk fills part of
+    // the way through.
+    for (const char* name : {"mesh.ply", "mesh.stl", "mesh.3mf"}) {
+        SCOPED_TRACE(name);
+        std::ofstream(disk / name) << "previous mesh";
+        const pid_t pid = dqj::test::spawnProgram(DQJ_CLI,
+                                                  {"mesh", "-q", "--force", "-r", "192", "--max-memory", "120M", "-o",
+                                                   (disk / name).string()},
+                                                  dir_ / "stderr.txt");
+        ASSERT_GT(pid, 0);
+        EXPECT_EQ(waitExit(pid), 1);
+        const std::string err = readFile(dir_ / "stderr.txt");
+        EXPECT_NE(err.find("No space left on device"), std::string::npos) << err;
+        EXPECT_EQ(filesIn(disk), std::vector<std::string>{name});
+        EXPECT_EQ(readFile(disk / name), "previous mesh");
+        fs::remove(disk / name);
+    }
 }
 
 // --- The C ABI from many threads -------------------------------------------------------

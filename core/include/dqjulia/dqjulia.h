@@ -218,8 +218,9 @@ DQJ_API dqj_status dqj_mesh_get_face_counts(dqj_context context, size_t* out_qua
  * copies nothing. */
 DQJ_API dqj_status dqj_mesh_copy_faces(dqj_context context, uint32_t* quads, size_t quad_capacity, uint32_t* triangles,
                                        size_t triangle_capacity);
-/* Writes the context's mesh to `path`: .ply (binary, with normals and colours) or .obj. Same
- * all-or-nothing file behaviour as dqj_bake_vdb. */
+/* Writes the context's mesh to `path`, by its extension: .ply (binary, with normals and colours),
+ * .obj, .stl (binary, triangles, no colours) or .3mf (vertex colours; unit millimetre), slice
+ * coordinates. Same all-or-nothing file behaviour as dqj_bake_vdb. */
 DQJ_API dqj_status dqj_mesh_write(dqj_context context, const char* path);
 
 /* What the context's last successful bake or mesh cost (zeros before the first). It may gain

@@ -1,4 +1,4 @@
-// dqjulia/mesh.hpp - a polygon mesh of the baked surface, and PLY / OBJ files of it.
+// dqjulia/mesh.hpp - a polygon mesh of the baked surface, and PLY / OBJ / STL / 3MF files of it.
 //
 // The mesh is OpenVDB's volumeToMesh of the bake's surface function (bake.hpp) at
 // bake.adaptivity - the very surface the bake's level set holds, since levelSetRebuild is the
@@ -18,6 +18,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -55,18 +56,51 @@ struct MeshCounts {
 DQJ_API Mesh bakeMesh(const Params& params, const BakeOptions& options = {}, const ProgressCallback& progress = {},
                       BakeStats* stats = nullptr);
 
+/// The length unit of a mesh file's coordinates (`dqjulia mesh --units`).
+enum class MeshUnit { Millimeter, Centimeter, Meter, Inch };
+
+/// A mesh file's physical size: a `size` scales the mesh uniformly so that its largest side is
+/// `size` units long and moves it into the positive octant (least corner at 0, as printers
+/// expect); none writes slice coordinates as they are. `unit` is the 3MF's unit attribute (the
+/// other formats carry no unit). Sizes above 0 up to kMaxMeshSizeMetres (1 km) are accepted.
+struct MeshScale {
+    MeshUnit unit = MeshUnit::Millimeter;
+    std::optional<double> size;
+};
+
+/// The unit's name in flags and docs ("mm", "cm", "m", "in") and its length in metres.
+DQJ_API const char* meshUnitName(MeshUnit unit);
+DQJ_API double meshUnitMetres(MeshUnit unit);
+/// The largest MeshScale::size, in metres (1 km: no print and no scene is larger).
+constexpr double kMaxMeshSizeMetres = 1000.0;
+/// Throws ParamError ("mesh.size") unless `scale.size` is none or a number above 0 no larger than
+/// kMaxMeshSizeMetres in its unit.
+DQJ_API void checkMeshScale(const MeshScale& scale);
+
+/// Throws ParamError ("output.path") unless `path` ends in a mesh file's extension: .ply, .obj,
+/// .stl or .3mf (any case).
+DQJ_API void checkMeshPath(const std::string& path);
+
 /// Meshes `params` into the file `path` (as writeMesh writes it), slab by slab where the memory
 /// limit asks for it, each slab written as it is made: the file appears complete or not at all
 /// (options.existing decides whether it may replace one). Throws like bakeMesh and writeMesh;
 /// Cancelled (the callback returned false, at any slab, or at 1.0 just before the file is published)
 /// leaves no file behind.
 DQJ_API MeshCounts bakeMeshFile(const Params& params, const std::string& path, const BakeOptions& options = {},
-                                const ProgressCallback& progress = {}, BakeStats* stats = nullptr);
+                                const ProgressCallback& progress = {}, BakeStats* stats = nullptr,
+                                const MeshScale& scale = {});
 
-/// Writes `.ply` (binary little-endian: float positions and normals, 8-bit sRGB colours,
-/// quads and triangles) or `.obj` (text: `v x y z [r g b]`, `vn`, `f a//a ...`), by the path's
-/// extension. Temporary file + rename. Throws ParamError for another extension,
+/// Writes a mesh file by the path's extension:
+/// - `.ply`: binary little-endian, float positions and normals, 8-bit sRGB colours, quads and
+///   triangles;
+/// - `.obj`: text, `v x y z [r g b]`, `vn`, `f a//a ...`;
+/// - `.stl`: binary STL, triangles (quads split along their 0-2 diagonal) with their face normals;
+///   no colours (STL has no standard way to hold them);
+/// - `.3mf`: the 3MF core mesh (triangles, as STL), vertex colours (sRGB) through the Materials
+///   extension's colour group, the unit from `scale`.
+/// Temporary file + rename. Throws ParamError for another extension or a bad `scale`,
 /// std::runtime_error for I/O.
-DQJ_API void writeMesh(const Mesh& mesh, const std::string& path, Existing existing = Existing::Replace);
+DQJ_API void writeMesh(const Mesh& mesh, const std::string& path, Existing existing = Existing::Replace,
+                       const MeshScale& scale = {});
 
 }  // namespace dqj

@@ -1,5 +1,5 @@
 // Meshes of the baked surface (mesh.hpp): the mesher (mesh_stream.hpp) into memory or into a
-// PLY or OBJ file (mesh_file.hpp).
+// PLY, OBJ, STL or 3MF file (mesh_file.hpp).
 #include "dqjulia/mesh.hpp"
 
 #include "bake/mesh_file.hpp"
@@ -44,9 +44,9 @@ Mesh bakeMesh(const Params& params, const BakeOptions& options, const ProgressCa
 }
 
 MeshCounts bakeMeshFile(const Params& params, const std::string& path, const BakeOptions& options,
-                        const ProgressCallback& progress, BakeStats* statsOut) {
+                        const ProgressCallback& progress, BakeStats* statsOut, const MeshScale& scale) {
     validate(params);
-    MeshFile file(path, params.bake.meshColors, options.existing);  // fails now, before the work
+    MeshFile file(path, params.bake.meshColors, options.existing, scale);  // fails now, before the work
     BakeStats stats;
     meshSurface(
         params, options, progress, [&file](Mesh&& part) { file.add(part); }, stats);
@@ -56,8 +56,8 @@ MeshCounts bakeMeshFile(const Params& params, const std::string& path, const Bak
     return file.counts();
 }
 
-void writeMesh(const Mesh& mesh, const std::string& path, Existing existing) {
-    MeshFile file(path, !mesh.colors.empty(), existing);
+void writeMesh(const Mesh& mesh, const std::string& path, Existing existing, const MeshScale& scale) {
+    MeshFile file(path, !mesh.colors.empty(), existing, scale);
     file.add(mesh);
     file.commit();
 }

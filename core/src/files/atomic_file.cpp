@@ -392,19 +392,24 @@ void ScratchFile::checkWrites() {
 }
 
 void ScratchFile::appendTo(AtomicFile& target) {
+    std::ostream& out = target.stream();
+    readBack([&out](const char* data, std::size_t size) { out.write(data, std::streamsize(size)); });
+    target.checkWrites();
+}
+
+void ScratchFile::readBack(const std::function<void(const char* data, std::size_t size)>& consume) {
     State& state = *state_;
     if (!state.buffer->drain()) checkWrites();  // throws: the write's reason
     if (platform::seekTo(state.fd, 0, SEEK_SET) < 0) throw systemError(path_, errno);
     std::vector<char> block(std::size_t(1) << 20);
-    std::ostream& out = target.stream();
     for (;;) {
         const std::int64_t got = platform::readSome(state.fd, block.data(), block.size());
         if (got < 0 && errno == EINTR) continue;
         if (got < 0) throw systemError(path_, errno);
         if (got == 0) break;
-        out.write(block.data(), std::streamsize(got));
+        consume(block.data(), std::size_t(got));
     }
-    target.checkWrites();
+    if (platform::seekTo(state.fd, 0, SEEK_END) < 0) throw systemError(path_, errno);  // later writes append
 }
 
 void checkWritable(const std::string& path, Existing existing) {

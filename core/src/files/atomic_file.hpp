@@ -14,11 +14,12 @@
 // the file system are platform::PendingFile's; the checks and their order are here.
 // AtomicFileSet publishes the several files of one run together: all of them or none.
 // ScratchFile holds data a writer sets aside until it goes into its AtomicFile (a streamed mesh's
-// faces, which follow all of its vertices): a file without a name beside the target, gone
-// whatever happens.
+// faces, which follow all of its vertices), or reads back itself: a file without a name beside
+// the target, gone whatever happens.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <ostream>
@@ -120,6 +121,9 @@ public:
     /// Appends everything written so far to `target`'s stream. Throws std::runtime_error when a
     /// write here failed or the data cannot be read back.
     void appendTo(AtomicFile& target);
+    /// Hands everything written so far to `consume` in blocks of up to a megabyte, from the start
+    /// (again at each call). Throws as appendTo.
+    void readBack(const std::function<void(const char* data, std::size_t size)>& consume);
 
     struct State;
 
