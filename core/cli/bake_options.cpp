@@ -78,6 +78,18 @@ void BakeFlags::addTo(CLI::App& command, BakeCommand kind) {
         command.add_option("--size", size,
                            "Scale the mesh so that its largest side is SIZE --units long (needs --units), its least "
                            "corner at 0 (for printing; up to 1 km); every format");
+        // The print check: always for .stl and .3mf, else with any of its flags.
+        command
+            .add_option("--min-wall", minWall,
+                        "Print check: walls thinner than W (output units, measured on the mesh's distance field) "
+                        "fail it; .stl and .3mf are then not written (docs: Baking, Printing)")
+            ->check(CLI::PositiveNumber);
+        command.add_option("--min-island", minIsland,
+                           "Print check: drop the islands (parts not connected to the rest) of fewer than N faces");
+        command.add_flag("--largest-only", largestOnly, "Print check: keep only the island with the most faces");
+        command.add_flag("--allow-unprintable", allowUnprintable,
+                         "Write .stl and .3mf even when the print check fails (not closed, not edge-manifold, a wall "
+                         "under --min-wall): the report still names the problems");
     } else {
         schemaOption(command, "--grids", "bake.grids", grids);
         schemaOption(command, "--band-width", "bake.band_width", bandWidth);

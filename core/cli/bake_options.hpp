@@ -40,6 +40,11 @@ struct BakeFlags {
     bool noColors = false;             // mesh only
     std::string units;                 // mesh only: --units (meshScale)
     std::optional<std::string> size;   // mesh only: --size, as given (meshScale)
+    // The print check (mesh only; print_check.hpp).
+    std::optional<double> minWall;
+    std::uint64_t minIsland = 0;
+    bool largestOnly = false;
+    bool allowUnprintable = false;
     std::string tiles;                 // bake and farm
     std::optional<int> tile;           // bake only
     std::optional<int> threads;        // bake and mesh
@@ -63,6 +68,8 @@ struct BakeFlags {
     std::uint64_t memoryLimit() const;
     /// --tiles (its index --tile, or 0 for every tile), if given. Throws ParamError.
     std::optional<Tile> tiling() const;
+    /// Whether a print check flag (--min-wall, --min-island, --largest-only) was given.
+    bool printCheckAsked() const { return minWall || minIsland > 0 || largestOnly; }
     /// --threads, or defaultThreadCount().
     int threadCount() const;
     /// What an existing output means: refused (the default), replaced (--force) or skipped

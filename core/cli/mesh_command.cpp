@@ -10,10 +10,42 @@
 #include "dqjulia/inspect.hpp"
 #include "dqjulia/mesh.hpp"
 #include "dqjulia/threads.hpp"
+#include "bake/print_check.hpp"
 #include "files/message_text.hpp"
 
 namespace dqj::cli {
 namespace {
+
+/// Stops before writing `path` when it is for printing and the check failed, unless
+/// --allow-unprintable; else shows the report (a failure always, as a warning).
+void refuseUnprintable(const BakeFlags& flags, const std::string& path, const PrintReport& report) {
+    const std::string failure = report.failure();
+    if (!flags.quiet || !failure.empty()) std::cerr << printReportText(report);
+    if (failure.empty()) return;
+    if (isPrintFormat(path) && !flags.allowUnprintable)
+        throw ParamError("output.path", "not printable, so '" + inputExcerpt(path) + "' was not written: " + failure +
+                                            " (--allow-unprintable writes it anyway)");
+    std::cerr << "dqjulia mesh: warning: " << path << " is not printable: " << failure << "\n";
+}
+
+/// The print check's lines for --stats: key value, the five largest islands numbered from 1.
+void printPrintStats(const PrintReport& report) {
+    std::cout << "print_closed " << report.closed() << "\nprint_boundary_edges " << report.boundaryEdges
+              << "\nprint_edge_manifold " << report.manifold() << "\nprint_nonmanifold_edges "
+              << report.nonManifoldEdges << "\nprint_islands " << report.islands.size() << "\nprint_dropped_islands "
+              << report.droppedIslands << "\nprint_dropped_faces " << report.droppedFaces << "\n";
+    for (std::size_t index = 0; index < std::min<std::size_t>(5, report.islands.size()); ++index) {
+        const PrintIsland& island = report.islands[index];
+        const glm::dvec3 size = island.max - island.min;
+        const std::string key = "print_island_" + std::to_string(index + 1);
+        std::cout << key << "_faces " << island.faces << "\n"
+                  << key << "_size " << size.x << " " << size.y << " " << size.z << "\n"
+                  << key << "_volume " << island.volume << "\n";
+    }
+    if (report.wallMeasured)
+        std::cout << "print_thinnest_wall " << report.thinnestWall << "\nprint_wall_found " << report.wallFound << "\n";
+    std::cout << "print_ok " << report.failure().empty() << "\n";
+}
 
 int runMesh(const BakeFlags& flags) {
     const Params params = flags.load();
@@ -38,6 +70,11 @@ int runMesh(const BakeFlags& flags) {
     for (const std::string& path : paths) outputs.push_back({"--output", path});
     checkOutputs(outputs, flags.fractal.inputs(), flags.force);
     const ThreadLimit threads(flags.threadCount());
+    const bool check = isPrintFormat(flags.output) || flags.printCheckAsked();
+    PrintOptions print;
+    print.minWall = flags.minWall.value_or(0.0);
+    print.minIslandFaces = flags.minIsland;
+    print.largestOnly = flags.largestOnly;
 
     for (std::size_t index = 0; index < frames.size(); ++index) {
         BakeMonitor monitor;
@@ -48,13 +85,26 @@ int runMesh(const BakeFlags& flags) {
         options.existing = existingPolicy(flags.force);
         BakeStats stats;
         MeshCounts mesh;
+        PrintReport report;
         {
             ProgressBar bar(frames.size() > 1 ? "meshing frame " + std::to_string(frames[index]) : "meshing",
                             flags.quiet);
             try {
-                // Written as it is made, slab by slab where the memory limit asks for it; the file
-                // appears only complete (a signal in the last moments, too, leaves nothing).
-                mesh = bakeMeshFile(perFrame[index], paths[index], options, bakeProgress(bar, monitor), &stats, scale);
+                if (check) {
+                    // Checked whole before it is written: refused, with nothing written, when unprintable.
+                    const ProgressCallback progress = bakeProgress(bar, monitor);
+                    const Mesh whole = meshForPrint(perFrame[index], options, print, progress, stats, report, scale);
+                    if (progress && !progress(1.0)) throw Cancelled();
+                    bar.finish();
+                    refuseUnprintable(flags, paths[index], report);
+                    writeMesh(whole, paths[index], options.existing, scale);
+                    mesh = MeshCounts{whole.positions.size(), whole.quads.size(), whole.triangles.size()};
+                } else {
+                    // Written as it is made, slab by slab where the memory limit asks for it; the file
+                    // appears only complete (a signal in the last moments, too, leaves nothing).
+                    mesh =
+                        bakeMeshFile(perFrame[index], paths[index], options, bakeProgress(bar, monitor), &stats, scale);
+                }
             } catch (const Cancelled&) {
                 bar.finish();
                 if (index == 0) throw;
@@ -78,6 +128,7 @@ int runMesh(const BakeFlags& flags) {
         if (flags.stats) {
             if (frames.size() > 1) std::cout << "frame " << frames[index] << "\n";
             printBakeStats(stats);
+            if (check) printPrintStats(report);
             std::cout << "slabs " << stats.slabs << "\nvertices " << mesh.vertices << "\nfaces " << faces << "\nquads "
                       << mesh.quads << "\ntriangles " << mesh.triangles << "\ntriangulated "
                       << mesh.triangles + 2 * mesh.quads << "\n";

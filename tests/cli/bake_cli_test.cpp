@@ -31,15 +31,7 @@ protected:
     Outcome run(const std::string& arguments) { return dqj::test::runCommand(DQJ_CLI, arguments, dir_); }
 };
 
-/// The value of "key N" in --stats output.
-double statValue(const std::string& text, const std::string& key) {
-    std::istringstream lines(text);
-    std::string line;
-    while (std::getline(lines, line))
-        if (line.rfind(key + " ", 0) == 0) return std::stod(line.substr(key.size() + 1));
-    ADD_FAILURE() << "no " << key << " in:\n" << text;
-    return -1.0;
-}
+using dqj::test::statValue;
 
 TEST_F(BakeCli, BakeAndMeshReportTheirWork) {
     const Outcome bake = run("bake -r 32 --stats -o '" + path("f.vdb") + "'");

@@ -112,6 +112,16 @@ inline pid_t spawnProgram(const std::string& program, const std::vector<std::str
     return status == 0 ? pid : -1;
 }
 
+/// The value of "key N" in a command's --stats output (the first number after the key).
+inline double statValue(const std::string& text, const std::string& key) {
+    std::istringstream lines(text);
+    std::string line;
+    while (std::getline(lines, line))
+        if (line.rfind(key + " ", 0) == 0) return std::stod(line.substr(key.size() + 1));
+    ADD_FAILURE() << "no " << key << " in:\n" << text;
+    return -1.0;
+}
+
 /// The names a command's --help lists in a section (e.g. "Subcommands:"), one per entry line ("  name  text").
 inline std::vector<std::string> helpSection(const std::string& help, const std::string& section) {
     std::vector<std::string> names;

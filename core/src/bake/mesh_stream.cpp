@@ -363,6 +363,7 @@ void meshSurface(const Params& params, const BakeOptions& options, const Progres
             finish();
             return;
         } catch (const MemoryLimitError& error) {
+            if (slabVoxels == kOnePieceOnly) throw;
             const std::string prefix = "bake.resolution: ";
             std::string message = error.what();
             if (message.rfind(prefix, 0) == 0) message.erase(0, prefix.size());

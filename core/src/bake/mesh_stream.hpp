@@ -40,8 +40,11 @@ constexpr int kSlabHalo = 16;
 /// faces index every vertex so far. A mesh in one piece is one part.
 using MeshPartSink = std::function<void(Mesh&& part)>;
 
+/// slabVoxels for meshSurface: in one piece, or MemoryLimitError where the limit would ask for slabs.
+constexpr int kOnePieceOnly = -1;
+
 /// Meshes `params` (validated) into `sink`. `slabVoxels` > 0 (a multiple of 8) forces slabs that
-/// thick (tests); 0 meshes in one piece where the limit allows. Fills `stats`. Throws like
+/// thick (tests); 0 meshes in one piece where the limit allows; kOnePieceOnly in one piece or not at all. Fills `stats`. Throws like
 /// bakeMesh: MemoryLimitError (before sampling), Cancelled, ParamError.
 void meshSurface(const Params& params, const BakeOptions& options, const ProgressCallback& progress,
                  const MeshPartSink& sink, BakeStats& stats, int slabVoxels = 0);
