@@ -70,6 +70,8 @@ void BakeFlags::addTo(CLI::App& command, BakeCommand kind) {
     if (mesh) {
         schemaOption(command, "--adaptivity", "bake.adaptivity", adaptivity);
         schemaOffFlag(command, "--no-colors", "bake.mesh_colors", noColors);
+        schemaOption(command, "--faces", "bake.max_faces", faces,
+                     "Made in one piece: past the memory limit's one-piece mesh it is refused before sampling");
     } else {
         schemaOption(command, "--grids", "bake.grids", grids);
         schemaOption(command, "--band-width", "bake.band_width", bandWidth);
@@ -166,6 +168,7 @@ Params BakeFlags::load() const {
     if (bandWidth) bake.bandWidth = *bandWidth;
     if (adaptivity) bake.adaptivity = *adaptivity;
     if (noColors) bake.meshColors = false;
+    if (faces) bake.maxFaces = *faces;
     if (!grids.empty()) {  // names the option's check accepted; one named twice is written once
         bake.grids.clear();
         std::size_t start = 0;

@@ -37,6 +37,7 @@ struct BakeFlags {
     std::string maxMemory;
     std::optional<double> adaptivity;  // mesh only
     bool noColors = false;             // mesh only
+    std::optional<int> faces;          // mesh only: bake.max_faces
     std::string tiles;                 // bake and farm
     std::optional<int> tile;           // bake only
     std::optional<int> threads;        // bake and mesh
