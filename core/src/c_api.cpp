@@ -509,7 +509,8 @@ dqj_status dqj_mesh_estimate(dqj_context context, uint64_t* outBytes, uint64_t* 
     return guarded(context, [&](dqj_context_t& self) {
         dqj::BakeOptions options;
         options.memoryLimit = self.memoryLimit;
-        const dqj::MeshEstimate estimate = dqj::estimateMesh(paramsNow(self), options, wrapProgress(progress, userData));
+        const dqj::MeshEstimate estimate =
+            dqj::estimateMesh(paramsNow(self), options, wrapProgress(progress, userData));
         if (outBytes) *outBytes = estimate.bytes;
         if (outSlabs) *outSlabs = estimate.slabs;
         if (outFaces) *outFaces = estimate.faces;

@@ -1414,7 +1414,11 @@ def case_cancel():
     job.join()
     task = job.tasks[0]
     check(
-        slabs == 1 and faces > 100000 and task.estimate is not None and task.estimate[1] >= 2 and task.estimate[0] <= limit,
+        slabs == 1
+        and faces > 100000
+        and task.estimate is not None
+        and task.estimate[1] >= 2
+        and task.estimate[0] <= limit,
         "the estimate: %s in one piece; %s under a limit of %d MB"
         % (jobs.describe_mesh_estimate(whole, slabs, faces), task.note, limit // 1000000),
     )

@@ -67,7 +67,8 @@ DQJ_API MeshCounts bakeMeshFile(const Params& params, const std::string& path, c
 struct MeshEstimate {
     std::uint64_t bytes = 0;  ///< the memory estimate checked against the limit: the one piece's, or the largest slab's
     std::uint64_t slabs = 0;  ///< 1: in one piece
-    std::uint64_t faces = 0;  ///< about how many triangles (a quad counts as two): within a third; at most bake.max_faces
+    std::uint64_t faces =
+        0;  ///< about how many triangles (a quad counts as two): within a third; at most bake.max_faces
     std::uint64_t limit = 0;  ///< the limit the estimate was checked against, in bytes
 };
 

@@ -55,7 +55,8 @@ glm::vec3 nearestOnTriangle(const glm::vec3& p, const glm::vec3& a, const glm::v
     const float vb = d5 * d2 - d1 * d6;
     if (vb <= 0.0f && d2 >= 0.0f && d6 <= 0.0f) return a + ac * (d2 / (d2 - d6));
     const float va = d3 * d6 - d5 * d4;
-    if (va <= 0.0f && (d4 - d3) >= 0.0f && (d5 - d6) >= 0.0f) return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    if (va <= 0.0f && (d4 - d3) >= 0.0f && (d5 - d6) >= 0.0f)
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
     const float sum = va + vb + vc;
     if (!(sum > 0.0f)) return a;  // a degenerate triangle: its corner will do (its edges are tested by neighbours)
     return a + ab * (vb / sum) + ac * (vc / sum);
@@ -69,7 +70,8 @@ public:
         std::vector<std::size_t> counts(triangles_.size());
         for (std::size_t index = 0; index < triangles_.size(); ++index) {
             const auto [lo, hi] = cellBox(index);
-            counts[index] = std::size_t(hi[0] - lo[0] + 1) * std::size_t(hi[1] - lo[1] + 1) * std::size_t(hi[2] - lo[2] + 1);
+            counts[index] =
+                std::size_t(hi[0] - lo[0] + 1) * std::size_t(hi[1] - lo[1] + 1) * std::size_t(hi[2] - lo[2] + 1);
         }
         std::size_t total = 0;
         for (const std::size_t count : counts) total += count;
@@ -78,7 +80,8 @@ public:
             const auto [lo, hi] = cellBox(index);
             for (std::int64_t x = lo[0]; x <= hi[0]; ++x)
                 for (std::int64_t y = lo[1]; y <= hi[1]; ++y)
-                    for (std::int64_t z = lo[2]; z <= hi[2]; ++z) entries_.push_back({key(x, y, z), std::uint32_t(index)});
+                    for (std::int64_t z = lo[2]; z <= hi[2]; ++z)
+                        entries_.emplace_back(key(x, y, z), std::uint32_t(index));
         }
         tbb::parallel_sort(entries_.begin(), entries_.end());
     }
@@ -119,7 +122,9 @@ private:
         return {cellOf(lo), cellOf(hi)};
     }
     static std::uint64_t key(std::int64_t x, std::int64_t y, std::int64_t z) {
-        auto part = [](std::int64_t v) { return std::uint64_t(std::clamp<std::int64_t>(v + kCellBias, 0, 2 * kCellBias - 1)); };
+        auto part = [](std::int64_t v) {
+            return std::uint64_t(std::clamp<std::int64_t>(v + kCellBias, 0, 2 * kCellBias - 1));
+        };
         return (part(x) << 42) | (part(y) << 21) | part(z);
     }
 

@@ -45,9 +45,9 @@ MeshDeviation meshDeviation(const Mesh& reference, const Mesh& mesh, double voxe
 /// What simplifyToFaces made.
 struct SimplifiedMesh {
     Mesh mesh;
-    double adaptivity = 0.0;        ///< the adaptivity chosen
+    double adaptivity = 0.0;          ///< the adaptivity chosen
     std::uint64_t fullTriangles = 0;  ///< the full mesh's triangles (a quad counts as two); 0: kept as it is
-    MeshDeviation deviation;        ///< from the full mesh
+    MeshDeviation deviation;          ///< from the full mesh
 };
 
 /// The mesh of at most `maxTriangles` triangles (a quad counts as two) that `meshAt` (the mesher
