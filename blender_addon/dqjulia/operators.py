@@ -415,11 +415,43 @@ class DQJULIA_OT_bake_volume(_BakeOperator, bpy.types.Operator):
         return "Baked %s (%s)" % (volume.name, path)
 
 
+# A mesh above these asks first (Bake Mesh's dialog): it takes minutes and gigabytes, and Blender
+# holds the mesh again once added.
+LARGE_MESH_BYTES = 1e9
+LARGE_MESH_FACES = 5e6
+
+
 class DQJULIA_OT_bake_mesh(_BakeOperator, bpy.types.Operator):
     """Mesh the set's surface at this frame and add it as a mesh object with normals and colours"""
 
     bl_idname = "dqjulia.bake_mesh"
     bl_label = "Bake Mesh"
+
+    _estimate = ""
+
+    def invoke(self, context, _event):
+        """The core's estimate first (the classification alone): a mesh that cannot fit is refused
+        with the core's reason before any work; a large one asks, showing memory, slabs and faces."""
+        obj = dqjulia_object(context)
+        if context.window is None or obj is None or native.load_error() or not native.has("dqj_mesh_estimate"):
+            return self.execute(context)
+        try:
+            with native.Context() as core:
+                core.set_params(_bake_document(obj))
+                size, slabs, faces = core.mesh_estimate()
+        except (native.NativeError, native.NativeUnavailable, ValueError, OSError) as error:
+            self.report({"ERROR"}, "Bake mesh: %s" % error)
+            return {"CANCELLED"}
+        self._estimate = jobs.describe_mesh_estimate(size, slabs, faces)
+        if slabs <= 1 and size < LARGE_MESH_BYTES and faces < LARGE_MESH_FACES:
+            return self.execute(context)
+        return context.window_manager.invoke_props_dialog(self, width=460)
+
+    def draw(self, context):
+        layout = self.layout
+        layout.label(text="Mesh at %d voxels?" % dqjulia_object(context).dqjulia.bake_resolution, icon="QUESTION")
+        layout.label(text=self._estimate[:1].upper() + self._estimate[1:])
+        layout.label(text="Progress shows in the status bar; Esc cancels at any slab.")
 
     def make_job(self, context, obj):
         document = _bake_document(obj)

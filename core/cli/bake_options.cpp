@@ -90,6 +90,8 @@ void BakeFlags::addTo(CLI::App& command, BakeCommand kind) {
         command.add_flag("--allow-unprintable", allowUnprintable,
                          "Write .stl and .3mf even when the print check fails (not closed, not edge-manifold, a wall "
                          "under --min-wall): the report still names the problems");
+        schemaOption(command, "--faces", "bake.max_faces", faces,
+                     "Made in one piece: past the memory limit's one-piece mesh it is refused before sampling");
     } else {
         schemaOption(command, "--grids", "bake.grids", grids);
         schemaOption(command, "--band-width", "bake.band_width", bandWidth);
@@ -186,6 +188,7 @@ Params BakeFlags::load() const {
     if (bandWidth) bake.bandWidth = *bandWidth;
     if (adaptivity) bake.adaptivity = *adaptivity;
     if (noColors) bake.meshColors = false;
+    if (faces) bake.maxFaces = *faces;
     if (!grids.empty()) {  // names the option's check accepted; one named twice is written once
         bake.grids.clear();
         std::size_t start = 0;

@@ -45,6 +45,7 @@ struct BakeFlags {
     std::uint64_t minIsland = 0;
     bool largestOnly = false;
     bool allowUnprintable = false;
+    std::optional<int> faces;          // mesh only: bake.max_faces
     std::string tiles;                 // bake and farm
     std::optional<int> tile;           // bake only
     std::optional<int> threads;        // bake and mesh

@@ -125,6 +125,11 @@ int runMesh(const BakeFlags& flags) {
                       << evaluatedSummary(stats) << "; " << std::fixed << std::setprecision(2) << stats.seconds
                       << " s)\n"
                       << std::defaultfloat;
+        if (!flags.quiet && stats.fullTriangles > 0)
+            std::cerr << "simplified from " << stats.fullTriangles << " triangles (adaptivity " << stats.adaptivity
+                      << "): every vertex within " << std::fixed << std::setprecision(2) << stats.deviationVertices
+                      << " voxels of the full mesh, every face within " << stats.deviationSamples << "\n"
+                      << std::defaultfloat;
         if (flags.stats) {
             if (frames.size() > 1) std::cout << "frame " << frames[index] << "\n";
             printBakeStats(stats);
@@ -132,6 +137,10 @@ int runMesh(const BakeFlags& flags) {
             std::cout << "slabs " << stats.slabs << "\nvertices " << mesh.vertices << "\nfaces " << faces << "\nquads "
                       << mesh.quads << "\ntriangles " << mesh.triangles << "\ntriangulated "
                       << mesh.triangles + 2 * mesh.quads << "\n";
+            if (stats.fullTriangles > 0)
+                std::cout << "full_triangles " << stats.fullTriangles << "\nadaptivity " << stats.adaptivity
+                          << "\ndeviation_vertices " << stats.deviationVertices << "\ndeviation_faces "
+                          << stats.deviationSamples << "\n";
         }
     }
     return kSuccess;

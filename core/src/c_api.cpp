@@ -504,6 +504,20 @@ dqj_status dqj_mesh_compute(dqj_context context, dqj_progress_fn progress, void*
     });
 }
 
+dqj_status dqj_mesh_estimate(dqj_context context, uint64_t* outBytes, uint64_t* outSlabs, uint64_t* outFaces,
+                             dqj_progress_fn progress, void* userData) {
+    return guarded(context, [&](dqj_context_t& self) {
+        dqj::BakeOptions options;
+        options.memoryLimit = self.memoryLimit;
+        const dqj::MeshEstimate estimate =
+            dqj::estimateMesh(paramsNow(self), options, wrapProgress(progress, userData));
+        if (outBytes) *outBytes = estimate.bytes;
+        if (outSlabs) *outSlabs = estimate.slabs;
+        if (outFaces) *outFaces = estimate.faces;
+        return DQJ_OK;
+    });
+}
+
 dqj_status dqj_mesh_get_sizes(dqj_context context, size_t* outVertexCount, size_t* outTriangleCount) {
     return guarded(context, [&](dqj_context_t& self) {
         if (outVertexCount) *outVertexCount = self.mesh.positions.size();

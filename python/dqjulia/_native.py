@@ -239,6 +239,7 @@ PROGRESS_FN = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_double, ctypes.c_void_p)
 _handle = ctypes.c_void_p
 _status = ctypes.c_int
 _size_p = ctypes.POINTER(ctypes.c_size_t)
+_uint64_p = ctypes.POINTER(ctypes.c_uint64)
 _char_buffer = ctypes.c_char_p
 
 _BAKE = (FEATURE_VDB, FEATURE_MESH)  # the calls bakes and meshes share
@@ -294,6 +295,11 @@ _SIGNATURES: Dict[str, Tuple[Any, List[Any], Optional[Tuple[str, ...]]]] = {
     "dqj_context_set_memory_limit": (_status, [_handle, ctypes.c_uint64], _BAKE),
     "dqj_bake_vdb": (_status, [_handle, ctypes.c_char_p, PROGRESS_FN, ctypes.c_void_p], (FEATURE_VDB,)),
     "dqj_mesh_compute": (_status, [_handle, PROGRESS_FN, ctypes.c_void_p], (FEATURE_MESH,)),
+    "dqj_mesh_estimate": (
+        _status,
+        [_handle, _uint64_p, _uint64_p, _uint64_p, PROGRESS_FN, ctypes.c_void_p],
+        (FEATURE_MESH,),
+    ),
     "dqj_mesh_get_sizes": (_status, [_handle, _size_p, _size_p], (FEATURE_MESH,)),
     "dqj_mesh_copy": (
         _status,
@@ -786,6 +792,22 @@ class Context:
 
     def mesh_compute(self, progress: Optional[Progress] = None) -> str:
         return self._run("mesh", _function("dqj_mesh_compute"), progress)
+
+    def mesh_estimate(self, progress: Optional[Progress] = None) -> Tuple[int, int, int]:
+        """(bytes, slabs, faces) mesh_compute would take with these parameters and memory limit,
+        from the classification alone: the memory estimate checked against the limit, the slabs
+        (1: one piece), about how many triangles. A mesh that cannot fit raises NativeError with
+        the reason (status DQJ_ERROR_OUT_OF_MEMORY)."""
+        size, slabs, faces = ctypes.c_uint64(0), ctypes.c_uint64(0), ctypes.c_uint64(0)
+        self._run(
+            "mesh estimate",
+            _function("dqj_mesh_estimate"),
+            progress,
+            ctypes.byref(size),
+            ctypes.byref(slabs),
+            ctypes.byref(faces),
+        )
+        return size.value, slabs.value, faces.value
 
     def mesh_sizes(self) -> Tuple[int, int]:
         vertices, triangles = ctypes.c_size_t(0), ctypes.c_size_t(0)

@@ -1393,6 +1393,48 @@ def case_cancel():
         files_under(CACHE) == files_before and set(bpy.data.objects.keys()) == objects_before,
         "no file and no object remain",
     )
+    # Bake Mesh slab by slab (a memory limit a third of the one piece's): the estimate first, in the
+    # status; cancelled in the slabs; a limit nothing fits fails with the core's reason.
+    s.bake_resolution = 320
+    document = props.to_document(s)
+    with native.Context() as core:
+        core.set_params(document)
+        whole, slabs, faces = core.mesh_estimate()
+    fixed = 96 * 1024 * 1024  # the core's fixed part of a mesh's estimate
+    limit = fixed + (whole - fixed) // 3
+    job = jobs.Job("Bake mesh", [jobs.MeshTask(document, memory_limit=limit)], owner=obj.name)
+    job.start()
+    statuses, cancelled_at = set(), None
+    while not job.finished_running:
+        statuses.add(job.status_text())
+        if job.fraction > 0.3 and not job.cancel_requested:
+            cancelled_at = job.fraction
+            job.cancel()
+        time.sleep(0.01)
+    job.join()
+    task = job.tasks[0]
+    check(
+        slabs == 1
+        and faces > 100000
+        and task.estimate is not None
+        and task.estimate[1] >= 2
+        and task.estimate[0] <= limit,
+        "the estimate: %s in one piece; %s under a limit of %d MB"
+        % (jobs.describe_mesh_estimate(whole, slabs, faces), task.note, limit // 1000000),
+    )
+    check(
+        any("slabs" in status for status in statuses),
+        "the status shows the slabs to come: %s" % sorted(statuses)[-1:],
+    )
+    check(
+        job.state == jobs.Job.CANCELLED and cancelled_at is not None,
+        "a slabbed mesh cancelled at %.0f%% stops" % (100 * (cancelled_at or 0)),
+    )
+    job = jobs.Job("Bake mesh", [jobs.MeshTask(document, memory_limit=1000)], owner=obj.name)
+    check(
+        job.run() == jobs.Job.FAILED and "does not fit the limit" in job.error,
+        "a mesh that cannot fit fails with the core's reason: %s" % job.error[:110],
+    )
     prefs = bpy.context.preferences.addons[MODULE].preferences
     blocker = os.path.join(ARGS.work, "not-a-folder")
     with open(blocker, "w") as file:

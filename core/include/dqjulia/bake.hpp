@@ -70,6 +70,13 @@ struct BakeStats {
     std::uint64_t estimatedBytes = 0;  ///< the memory estimate checked against the limit (slabs: the largest's)
     std::uint64_t slabs = 0;           ///< meshes: the slabs it was made in (1: one piece); bakes: 0
     double voxelSize = 0.0;            ///< h, in slice units
+    /// Meshes with bake.max_faces (mesh_simplify.hpp): the adaptivity chosen, the full mesh's
+    /// triangles, and the farthest vertex and face point of the result from the full mesh, in
+    /// voxels; all 0 when the full mesh met the limit (or without it).
+    double adaptivity = 0.0;
+    std::uint64_t fullTriangles = 0;
+    double deviationVertices = 0.0;
+    double deviationSamples = 0.0;
     double seconds = 0.0;
 };
 

@@ -190,9 +190,21 @@ DQJ_API dqj_status dqj_context_set_memory_limit(dqj_context context, uint64_t by
  * a cancel an existing file at `path` is untouched and no temporary file remains. */
 DQJ_API dqj_status dqj_bake_vdb(dqj_context context, const char* path, dqj_progress_fn progress, void* user_data);
 
-/* Meshes the surface (OpenVDB volumeToMesh at the bake resolution and bake.adaptivity) and keeps
- * the mesh in the context, replacing the previous one (which is kept if this call fails). */
+/* Meshes the surface (OpenVDB volumeToMesh at the bake resolution and bake.adaptivity, or at
+ * most bake.max_faces triangles: docs/baking.md gives the error bound), slab by slab where the
+ * memory limit asks for it, and keeps the mesh in the context, replacing the previous one
+ * (which is kept if this call fails). */
 DQJ_API dqj_status dqj_mesh_compute(dqj_context context, dqj_progress_fn progress, void* user_data);
+/* What dqj_mesh_compute would take with the context's parameters and memory limit, known before
+ * it starts (from the classification of the surface's blocks alone: a few percent of the mesh's
+ * time; `progress` as dqj_mesh_compute's, and it may cancel): `out_bytes` the memory estimate
+ * checked against the limit (the one piece's, or the largest slab's), `out_slabs` the slabs it
+ * will be made in (1: one piece), `out_faces` about how many triangles (quads count as two;
+ * within a third; at most bake.max_faces). Any pointer may be NULL. A mesh that cannot fit the
+ * limit even slab by slab (adaptive and bake.max_faces meshes: in one piece) gives
+ * DQJ_ERROR_OUT_OF_MEMORY with the reason, as dqj_mesh_compute would. */
+DQJ_API dqj_status dqj_mesh_estimate(dqj_context context, uint64_t* out_bytes, uint64_t* out_slabs, uint64_t* out_faces,
+                                     dqj_progress_fn progress, void* user_data);
 /* The sizes of the context's mesh: vertices, and triangles (quads count as two). 0 and 0 before
  * the first dqj_mesh_compute. Either pointer may be NULL. */
 DQJ_API dqj_status dqj_mesh_get_sizes(dqj_context context, size_t* out_vertex_count, size_t* out_triangle_count);

@@ -90,6 +90,22 @@ DQJ_API MeshCounts bakeMeshFile(const Params& params, const std::string& path, c
                                 const ProgressCallback& progress = {}, BakeStats* stats = nullptr,
                                 const MeshScale& scale = {});
 
+/// What meshing `params` will take, known before it starts (estimateMesh).
+struct MeshEstimate {
+    std::uint64_t bytes = 0;  ///< the memory estimate checked against the limit: the one piece's, or the largest slab's
+    std::uint64_t slabs = 0;  ///< 1: in one piece
+    std::uint64_t faces =
+        0;  ///< about how many triangles (a quad counts as two): within a third; at most bake.max_faces
+    std::uint64_t limit = 0;  ///< the limit the estimate was checked against, in bytes
+};
+
+/// What bakeMesh or bakeMeshFile would take with `params` (validated) and `options`, from the
+/// classification of the blocks alone (no sampling: a few percent of the mesh's time). Throws
+/// MemoryLimitError with the reason when the mesh cannot fit the limit even slab by slab (or,
+/// for adaptive and bake.max_faces meshes, in one piece), as bakeMesh would; Cancelled.
+DQJ_API MeshEstimate estimateMesh(const Params& params, const BakeOptions& options = {},
+                                  const ProgressCallback& progress = {});
+
 /// Writes a mesh file by the path's extension:
 /// - `.ply`: binary little-endian, float positions and normals, 8-bit sRGB colours, quads and
 ///   triangles;

@@ -96,6 +96,9 @@ struct BakeSettings {
     std::vector<BakeGrid> grids{BakeGrid::Surface, BakeGrid::Density, BakeGrid::Color};
     double adaptivity = 0.0;  ///< mesh adaptivity 0..1 (OpenVDB volumeToMesh): 0 = uniform quads
     bool meshColors = true;   ///< vertex colours from the material's colouring
+    /// Meshes: at most this many triangles (a quad counts as two), by the least adaptivity that
+    /// meets it (mesh_simplify.hpp); 0 = no limit (bake.adaptivity applies).
+    int maxFaces = 0;
     /// How deep inside the attribute grids (color, trap, iterations) reach, as a fraction of the
     /// resolution (the bake's largest side): 0.02 = 5 voxels at 256, 20 at 1024; at least the band.
     double colorDepth = 0.02;

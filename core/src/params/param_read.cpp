@@ -289,6 +289,7 @@ void readBake(ObjectReader reader, BakeSettings& bake) {
             bake.grids.push_back(reader.choice<BakeGrid>((*value)[index], indexed(key, index), key));
     }
     reader.read("adaptivity", bake.adaptivity);
+    reader.read("max_faces", bake.maxFaces);
     reader.read("mesh_colors", bake.meshColors);
     reader.read("color_depth", bake.colorDepth);
     reader.finish();

@@ -114,6 +114,8 @@ void validate(const Params& params) {
         for (int axis = 0; axis < 3; ++axis)
             if (!(bake.bounds->min[axis] < bake.bounds->max[axis]))
                 fail("bake.bounds", "min must be below max on every axis (x, y, z)");
+    if (bake.maxFaces > 0 && bake.adaptivity > 0.0)
+        fail("bake.max_faces", "chooses the adaptivity itself: give bake.max_faces or bake.adaptivity, not both");
 
     // Keyframes: a rotation track needs its rotation, and the parameters at every key must pass
     // the rules above (checkFrames, keyframes.cpp, checks the frames between keys).

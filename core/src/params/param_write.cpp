@@ -94,6 +94,7 @@ std::string toJson(const Params& params) {
     bakeJson["band_width"] = bake.bandWidth;
     bakeJson["grids"] = grids;
     bakeJson["adaptivity"] = bake.adaptivity;
+    bakeJson["max_faces"] = bake.maxFaces;
     bakeJson["mesh_colors"] = bake.meshColors;
     bakeJson["color_depth"] = bake.colorDepth;
     document["bake"] = bakeJson;

@@ -355,6 +355,10 @@ const Field kFields[] = {
      false, false, 1, 8},
     {"bake.grids", Type::ChoiceSet, "Grids", "The grids a volume bake writes", 1, 5, false, false, 1, 5, kGrids},
     {"bake.adaptivity", Type::Number, "Adaptivity", "Mesh adaptivity: 0 = uniform quads, more = fewer faces", 0, 1},
+    {"bake.max_faces", Type::Integer, "Max faces",
+     "Meshes: at most this many triangles (a quad counts as two), made by the least adaptivity that meets it, every "
+     "vertex within 1.5 voxels of the full mesh (docs/baking.md); 0 = no limit",
+     0, 2000000000, false, false, 0, 10000000},
     {"bake.mesh_colors", Type::Boolean, "Vertex colours", "Vertex colours from the material's colouring"},
     {"bake.color_depth", Type::Number, "Colour depth",
      "How deep below the surface the colour, trap and iteration grids reach, as a fraction of the bake's largest side "
