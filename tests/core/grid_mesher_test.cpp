@@ -54,7 +54,8 @@ openvdb::FloatGrid::Ptr sphere() {
     for (int x = -14; x <= 14; ++x)
         for (int y = -14; y <= 14; ++y)
             for (int z = -14; z <= 14; ++z) {
-                const double distance = std::sqrt((x - 0.3) * (x - 0.3) + (y + 0.2) * (y + 0.2) + (z - 0.1) * (z - 0.1)) - 10.0;
+                const double distance =
+                    std::sqrt((x - 0.3) * (x - 0.3) + (y + 0.2) * (y + 0.2) + (z - 0.1) * (z - 0.1)) - 10.0;
                 if (std::abs(distance) < 3.0) accessor.setValue(openvdb::Coord(x, y, z), float(distance));
             }
     return grid;
@@ -69,8 +70,8 @@ openvdb::FloatGrid::Ptr pieces() {
     for (int x = 0; x < 48; ++x)
         for (int y = 0; y < 48; ++y)
             for (int z = 0; z < 48; ++z)
-                accessor.setValue(openvdb::Coord(x, y, z),
-                                  float(std::sin(0.41 * x + 0.2) * std::sin(0.37 * y - 0.1) * std::sin(0.45 * z + 0.3)));
+                accessor.setValue(openvdb::Coord(x, y, z), float(std::sin(0.41 * x + 0.2) * std::sin(0.37 * y - 0.1) *
+                                                                 std::sin(0.45 * z + 0.3)));
     return grid;
 }
 
@@ -88,9 +89,7 @@ TEST(GridMesher, InsidePositiveSameAsVolumeToMesh) {
     expectSameAsVolumeToMesh(grid, 0.0, 500);
 }
 
-TEST(GridMesher, ManyPiecesSameAsVolumeToMesh) {
-    expectSameAsVolumeToMesh(pieces(), 0.0, 10000);
-}
+TEST(GridMesher, ManyPiecesSameAsVolumeToMesh) { expectSameAsVolumeToMesh(pieces(), 0.0, 10000); }
 
 TEST(GridMesher, AdaptiveSameAsVolumeToMesh) {
     expectSameAsVolumeToMesh(sphere(), 0.5, 50);

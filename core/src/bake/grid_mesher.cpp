@@ -52,7 +52,8 @@ GridMesh meshGrid(openvdb::FloatGrid::Ptr& grid, double adaptivity) {
     const tbb::blocked_range<std::size_t> leaves(0, signLeaves.size());
 
     // Each leaf's first point: its count, summed in leaf order.
-    std::unique_ptr<openvdb::Index32[]> firstPoint(new openvdb::Index32[signLeaves.size()]);
+    std::unique_ptr<openvdb::Index32[]> firstPoint =
+        std::make_unique_for_overwrite<openvdb::Index32[]>(signLeaves.size());
     tbb::parallel_for(leaves, internal::LeafNodePointCount<Int16Tree::LeafNodeType::LOG2DIM>(signLeaves, firstPoint));
     openvdb::Index32 points = 0;
     for (std::size_t leaf = 0; leaf < signLeaves.size(); ++leaf) {
@@ -61,7 +62,7 @@ GridMesh meshGrid(openvdb::FloatGrid::Ptr& grid, double adaptivity) {
         points += count;
     }
     mesh.pointCount = points;
-    mesh.points.reset(new openvdb::Vec3s[points]);
+    mesh.points = std::make_unique_for_overwrite<openvdb::Vec3s[]>(points);
     tbb::parallel_for(leaves, internal::ComputePoints<FloatTree>(mesh.points.get(), tree, indexLeaves, signLeaves,
                                                                  firstPoint, grid->transform(), isovalue));
     grid.reset();  // the polygons need the flags and the indices, no more the values
@@ -69,7 +70,7 @@ GridMesh meshGrid(openvdb::FloatGrid::Ptr& grid, double adaptivity) {
     platform::releaseFreedMemory();  // its pages handed back: 3 to 5 MB off the 512^3 peaks
 
     mesh.poolCount = signLeaves.size();
-    mesh.pools.reset(new openvdb::tools::PolygonPool[mesh.poolCount]);
+    mesh.pools = std::make_unique<openvdb::tools::PolygonPool[]>(mesh.poolCount);
     tbb::parallel_for(leaves, internal::ComputePolygons<Int16Tree, internal::UniformPrimBuilder>(
                                   signLeaves, signFlags, pointIndices, mesh.pools, invertOrientation));
     return mesh;
