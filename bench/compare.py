@@ -12,7 +12,8 @@ Measures, in one run on this machine, and prints a table of ratios:
      (j component nonzero, k still 0, so POV-Ray's k = 0 slice is the same set). With
      --baseline, another dqjulia binary (an older build) is timed in the same interleaved runs;
   2. mesh at 256^3 and 512^3 by `dqjulia mesh` against Mandelbulber 2's marching-cubes PLY export
-     (`mandelbulber2 -n -V ply`) of the same set and box; time and peak memory;
+     (`mandelbulber2 -n -V ply`) of the same set and box; time and peak memory; on the bench's set
+     and on a second one, the "rabbit" (MESH_SCENES);
   3. bake (`dqjulia bake`) of the level set and the fog volume (grids surface and density) at
      256^3, 512^3, 1024^3 and 2048^3, and the growth exponent of its time with the resolution
      (2 = proportional to the surface, 3 = to the volume); then of the default grids (with the
@@ -27,7 +28,7 @@ max_iteration 13 tests z_0..z_12 as our N = 12 tests z_1..z_12 (z_0 lies inside 
 sphere anyway). Mandelbulber's mesh is the level set of its distance estimate at half a voxel,
 not the escape set, so its surface sits slightly outside ours.
 
-Usage: bench/compare.py [--build DIR] [--repeat N] [--skip-mesh] [--skip-bake] [--skip-kernel]
+Usage: bench/compare.py [--build DIR] [--repeat N] [--skip-render] [--skip-mesh] [--skip-bake] [--skip-kernel]
                         [--mesh-resolutions 256,512] [--bake-resolutions 256,512,1024,2048]
                         [--color-resolutions 256,512] [--keep DIR]
                         [--baseline DQJULIA]
@@ -64,6 +65,20 @@ LIGHTS = [((0.6, 0.8, 0.7), (1.0, 0.96, 0.9)), ((-0.7, 0.2, -0.5), (0.55 * 0.35,
 SCENES = [
     {"name": "bench", "c": C, "n": N},
     {"name": "second", "c": (-0.55, 0.1, 0.45, 0.0), "n": 10},
+]
+
+
+# The mesh scenes: the bench's set, and a second one with more surface (1.5 times the bench's
+# faces): c = (-0.12, 0.6, 0.45, 0) lies in the (1, i, j) space, so its k = 0 slice is closed
+# under the iteration and is exactly Mandelbulber's formula 5 in Julia mode with julia_c
+# (-0.12, 0.6, 0.45), as for the bench's set. A quaternion Julia set whose c lies in a complex
+# plane is the complex Julia set of that plane turned about the axis of c's imaginary part:
+# here the Douady rabbit (-0.12 + 0.75i), its axis in the slice at 37 degrees to the i axis, so
+# unlike the bench's set it is not aligned with the voxel grid. Same box, resolution, N and
+# bailout rule in both programs.
+MESH_SCENES = [
+    SCENES[0],
+    {"name": "rabbit", "c": (-0.12, 0.6, 0.45, 0.0), "n": 12},
 ]
 
 
@@ -241,7 +256,7 @@ def dqjulia_params(path, c=C, n=N, defaults=False, grids=None):
         json.dump(params, out, indent=2)
 
 
-def mandelbulber_settings(path, resolution, output):
+def mandelbulber_settings(path, resolution, output, c=C, n=N):
     def number(x):  # Mandelbulber's settings files use a decimal comma
         return repr(float(x)).replace(".", ",")
     with open(path, "w") as settings:
@@ -251,16 +266,16 @@ def mandelbulber_settings(path, resolution, output):
 [main_parameters]
 formula_1 5;
 julia_mode true;
-julia_c {number(C[0])} {number(C[1])} {number(C[2])};
-N {N};
-bailout {number(bailout())};
+julia_c {number(c[0])} {number(c[1])} {number(c[2])};
+N {n};
+bailout {number(bailout(c))};
 voxel_custom_limit_enabled true;
 voxel_limit_min {number(-BOX)} {number(-BOX)} {number(-BOX)};
 voxel_limit_max {number(BOX)} {number(BOX)} {number(BOX)};
 voxel_samples_x {resolution};
 voxel_samples_y {resolution};
 voxel_samples_z {resolution};
-voxel_max_iter {N};
+voxel_max_iter {n};
 mesh_output_filename {output};
 [fractal_1]
 """)
@@ -325,6 +340,7 @@ def main():
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     parser.add_argument("--build", default=os.path.join(root, "build-bench"), help="dqjulia build folder")
     parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--skip-render", action="store_true")
     parser.add_argument("--skip-mesh", action="store_true")
     parser.add_argument("--skip-bake", action="store_true")
     parser.add_argument("--skip-kernel", action="store_true")
@@ -390,6 +406,67 @@ def render_rows(args, dqjulia, work, rows, label, case, defaults):
                  "cleaner" if ours_speckle < pov_speckle else "NOT cleaner", "cleaner", ours_speckle < pov_speckle))
 
 
+def mesh_rows(args, dqjulia, work, rows):
+    """Times `dqjulia mesh` against Mandelbulber 2 on each of MESH_SCENES at each resolution (the
+    programs interleaved, medians of --repeat runs) and appends the rows: wall time, peak memory,
+    the peak above each program's floor, sizes, and the two meshes' bounding boxes (same object)."""
+    def mesh_commands(scene, resolution):
+        tag = f"{scene['name']}_{resolution}"
+        params = os.path.join(work, f"mesh_{scene['name']}.json")
+        dqjulia_params(params, scene["c"], scene["n"])
+        ours_ply = os.path.join(work, f"dqjulia_{tag}.ply")
+        mb_ply = os.path.join(work, f"mandelbulber_{tag}.ply")
+        settings = os.path.join(work, f"mandelbulber_{tag}.fract")
+        mandelbulber_settings(settings, resolution, mb_ply, scene["c"], scene["n"])
+        return ours_ply, mb_ply, {
+            "dqjulia": [dqjulia, "mesh", "-q", "-f", "-p", params, "-r", str(resolution), "--bounds-min",
+                        str(-BOX), str(-BOX), str(-BOX), "--bounds-max", str(BOX), str(BOX), str(BOX), "-o", ours_ply],
+            "mandelbulber2": ["mandelbulber2", "-n", "-V", "ply", settings],
+        }
+
+    # Each program's floor: the peak of a 16^3 mesh (its libraries, mapped and relocated).
+    floors = median_runs(mesh_commands(MESH_SCENES[0], 16)[2], 1, cwd=work, warm_up=True)
+    rows.append(("mesh 16^3 peak MB (floor)", f"{floors['dqjulia']['peak_kb'] / 1024:.0f}",
+                 f"Mandelbulber {floors['mandelbulber2']['peak_kb'] / 1024:.0f}", "", "", None))
+    for scene in MESH_SCENES:
+        name = "" if scene is MESH_SCENES[0] else f" {scene['name']}"
+        for resolution in [int(r) for r in args.mesh_resolutions.split(",")]:
+            ours_ply, mb_ply, commands = mesh_commands(scene, resolution)
+            short = resolution <= 256
+            times = median_runs(commands, args.repeat, cwd=work, warm_up=short)
+            ratio = times["mandelbulber2"]["wall"] / times["dqjulia"]["wall"]
+            cpu_ratio = times["mandelbulber2"]["cpu"] / times["dqjulia"]["cpu"]
+            memory = times["mandelbulber2"]["peak_kb"] / times["dqjulia"]["peak_kb"]
+            target = resolution == 512
+            label = f"mesh{name} {resolution}^3"
+            rows.append((f"{label} wall s", f"{times['dqjulia']['wall']:.2f}",
+                         f"Mandelbulber {times['mandelbulber2']['wall']:.2f}", f"{ratio:.1f}x faster",
+                         ">= 50x" if target else "", ratio >= 50.0 if target else None))
+            rows.append((f"{label} CPU s", f"{times['dqjulia']['cpu']:.2f}",
+                         f"Mandelbulber {times['mandelbulber2']['cpu']:.2f}", f"{cpu_ratio:.1f}x less", "", None))
+            rows.append((f"{label} peak MB", f"{times['dqjulia']['peak_kb'] / 1024:.0f}",
+                         f"Mandelbulber {times['mandelbulber2']['peak_kb'] / 1024:.0f}", f"{memory:.2f}x less",
+                         "less" if target else "", memory > 1.0 if target else None))
+            ours_work = times["dqjulia"]["peak_kb"] - floors["dqjulia"]["peak_kb"]
+            mb_work = times["mandelbulber2"]["peak_kb"] - floors["mandelbulber2"]["peak_kb"]
+            rows.append((f"{label} peak above floor MB", f"{ours_work / 1024:.0f}",
+                         f"Mandelbulber {mb_work / 1024:.0f}", f"{mb_work / max(ours_work, 1):.2f}x less", "", None))
+            ov, of = ply_summary(ours_ply)
+            mv, mf = ply_summary(mb_ply)
+            rows.append((f"{label} vertices/faces", f"{ov}/{of}", f"Mandelbulber {mv}/{mf}", "", "", None))
+            # Same object: the boxes of the two meshes, in voxels (Mandelbulber's surface is its
+            # DE = half a voxel, so it sits about a voxel further out).
+            voxel = 2 * BOX / resolution
+            (olow, ohigh), (mlow, mhigh) = ply_bounds(ours_ply), ply_bounds(mb_ply)
+            gap = max(max(abs(a - b) for a, b in zip(olow, mlow)), max(abs(a - b) for a, b in zip(ohigh, mhigh))) / voxel
+            rows.append((f"{label} bounding boxes", "", "", f"differ by {gap:.1f} voxels", "same object",
+                         gap < 0.02 * resolution))
+            if not args.keep:  # tens of MB each
+                for path in (ours_ply, mb_ply):
+                    if os.path.exists(path):
+                        os.remove(path)
+
+
 def compare(args, dqjulia, work):
     """Runs the measurements in the folder `work` and prints the table."""
     params = os.path.join(work, "quaternion_julia.json")
@@ -399,58 +476,17 @@ def compare(args, dqjulia, work):
 
     # 1. Render against POV-Ray: the bench scene in POV-Ray's look, each program on its
     # defaults, then the second scene in POV-Ray's look.
-    if ensure_installed("povray", "povray"):
+    if not args.skip_render and ensure_installed("povray", "povray"):
         cases = [("", SCENES[0], False), (" defaults", SCENES[0], True), (f" {SCENES[1]['name']}", SCENES[1], False)]
         for label, case, defaults in cases:
             render_rows(args, dqjulia, work, rows, label, case, defaults)
 
-    # 2. Mesh against Mandelbulber 2.
+    # 2. Mesh against Mandelbulber 2, on each of MESH_SCENES.
     if not args.skip_mesh:
         if not has_subcommand(dqjulia, "mesh"):
             rows.append(("mesh", "pending", "", "dqjulia mesh is not built (bake issue)", "", None))
         elif ensure_installed("mandelbulber2", "mandelbulber2"):
-            def mesh_commands(resolution):
-                ours_ply = os.path.join(work, f"dqjulia_{resolution}.ply")
-                mb_ply = os.path.join(work, f"mandelbulber_{resolution}.ply")
-                settings = os.path.join(work, f"mandelbulber_{resolution}.fract")
-                mandelbulber_settings(settings, resolution, mb_ply)
-                return ours_ply, mb_ply, {
-                    "dqjulia": [dqjulia, "mesh", "-q", "-f", "-p", params, "-r", str(resolution), "--bounds-min",
-                                str(-BOX), str(-BOX), str(-BOX), "--bounds-max", str(BOX), str(BOX), str(BOX), "-o", ours_ply],
-                    "mandelbulber2": ["mandelbulber2", "-n", "-V", "ply", settings],
-                }
-
-            # Each program's floor: the peak of a 16^3 mesh (its libraries, mapped and relocated).
-            floors = median_runs(mesh_commands(16)[2], 1, cwd=work, warm_up=True)
-            rows.append(("mesh 16^3 peak MB (floor)", f"{floors['dqjulia']['peak_kb'] / 1024:.0f}",
-                         f"Mandelbulber {floors['mandelbulber2']['peak_kb'] / 1024:.0f}", "", "", None))
-            for resolution in [int(r) for r in args.mesh_resolutions.split(",")]:
-                ours_ply, mb_ply, commands = mesh_commands(resolution)
-                short = resolution <= 256
-                times = median_runs(commands, args.repeat if short else 1, cwd=work, warm_up=short)
-                ratio = times["mandelbulber2"]["wall"] / times["dqjulia"]["wall"]
-                memory = times["mandelbulber2"]["peak_kb"] / times["dqjulia"]["peak_kb"]
-                target = resolution == 512
-                rows.append((f"mesh {resolution}^3 wall s", f"{times['dqjulia']['wall']:.2f}",
-                             f"Mandelbulber {times['mandelbulber2']['wall']:.2f}", f"{ratio:.1f}x faster",
-                             ">= 50x" if target else "", ratio >= 50.0 if target else None))
-                rows.append((f"mesh {resolution}^3 peak MB", f"{times['dqjulia']['peak_kb'] / 1024:.0f}",
-                             f"Mandelbulber {times['mandelbulber2']['peak_kb'] / 1024:.0f}", f"{memory:.2f}x less",
-                             "less" if target else "", memory > 1.0 if target else None))
-                ours_work = times["dqjulia"]["peak_kb"] - floors["dqjulia"]["peak_kb"]
-                mb_work = times["mandelbulber2"]["peak_kb"] - floors["mandelbulber2"]["peak_kb"]
-                rows.append((f"mesh {resolution}^3 peak above floor MB", f"{ours_work / 1024:.0f}",
-                             f"Mandelbulber {mb_work / 1024:.0f}", f"{mb_work / max(ours_work, 1):.2f}x less", "", None))
-                ov, of = ply_summary(ours_ply)
-                mv, mf = ply_summary(mb_ply)
-                rows.append((f"mesh {resolution}^3 vertices/faces", f"{ov}/{of}", f"Mandelbulber {mv}/{mf}", "", "", None))
-                # Same object: the boxes of the two meshes, in voxels (Mandelbulber's surface is
-                # its DE = half a voxel, so it sits about a voxel further out).
-                voxel = 2 * BOX / resolution
-                (olow, ohigh), (mlow, mhigh) = ply_bounds(ours_ply), ply_bounds(mb_ply)
-                gap = max(max(abs(a - b) for a, b in zip(olow, mlow)), max(abs(a - b) for a, b in zip(ohigh, mhigh))) / voxel
-                rows.append((f"mesh {resolution}^3 bounding boxes", "", "", f"differ by {gap:.1f} voxels",
-                             "same object", gap < 0.02 * resolution))
+            mesh_rows(args, dqjulia, work, rows)
 
     # 3. Bake growth: the level set and the fog volume (issue 15's measure), then the default
     # grids (with the colour grid) at the --color-resolutions.

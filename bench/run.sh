@@ -4,7 +4,8 @@
 # benchmarks into build-bench/, then runs bench/compare.py, which prints the table of
 # same-run ratios (docs/performance.md). Extra arguments go to compare.py, e.g.
 #   bench/run.sh --skip-mesh --bake-resolutions 256,512
-# Not part of the test command: benchmarks are not tests. Takes 10 to 20 minutes on 2 cores.
+# Not part of the test command: benchmarks are not tests. Takes 15 to 25 minutes on 2 cores (the
+# 512^3 meshes, three runs of Mandelbulber 2 on each of two scenes, are about half of it).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh libbenchmark-dev mandelbulber2 time

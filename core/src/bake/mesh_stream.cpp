@@ -10,12 +10,12 @@
 #include <unordered_map>
 
 #include <glm/geometric.hpp>
-#include <openvdb/tools/VolumeToMesh.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include "dqjulia/batch.hpp"
 #include "dqjulia/coloring.hpp"
+#include "bake/grid_mesher.hpp"
 #include "bake/level_set.hpp"
 #include "bake/memory.hpp"
 #include "bake/mesh_simplify.hpp"
@@ -135,36 +135,33 @@ std::vector<glm::vec3> vertexNormals(const Mesh& mesh) {
     return normals;
 }
 
-/// OpenVDB's mesher, used directly, not through volumeToMesh(): its point list and polygon pools
-/// become the mesh's arrays, each freed once copied (after the grid, which is let go once
-/// meshed), so the mesh is never held twice. Faces are counter-clockwise seen from the positive
-/// (outside) side.
+/// OpenVDB's mesher (grid_mesher.hpp: the grid let go once read): its point list and polygon
+/// pools become the mesh's arrays, each freed once copied, so the mesh is never held twice.
+/// Faces are counter-clockwise seen from the positive (outside) side.
 Mesh meshOfGrid(openvdb::FloatGrid::Ptr& grid, double adaptivity, const ProgressCallback& progress) {
     Mesh mesh;
     parallelForWithProgress(1, progress, [&](std::size_t, const std::atomic<bool>&) {
-        openvdb::tools::VolumeToMesh mesher(0.0, adaptivity);
-        mesher(*grid);
-        grid.reset();
+        GridMesh mesher = meshGrid(grid, adaptivity);
         platform::releaseFreedMemory();
-        const openvdb::Vec3s* points = mesher.pointList().get();
-        mesh.positions.resize(mesher.pointListSize());
+        const openvdb::Vec3s* points = mesher.points.get();
+        mesh.positions.resize(mesher.pointCount);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.positions.size()), [&](const auto& range) {
             for (std::size_t index = range.begin(); index < range.end(); ++index)
                 mesh.positions[index] = glm::vec3(points[index].x(), points[index].y(), points[index].z());
         });
-        mesher.pointList().reset();
+        mesher.points.reset();
         // Each pool goes to its place in the face arrays (pool order, as one after another), then is freed.
-        const std::size_t pools = mesher.polygonPoolListSize();
+        const std::size_t pools = mesher.poolCount;
         std::vector<std::size_t> quadsBefore(pools + 1, 0), trianglesBefore(pools + 1, 0);
         for (std::size_t pool = 0; pool < pools; ++pool) {
-            quadsBefore[pool + 1] = quadsBefore[pool] + mesher.polygonPoolList()[pool].numQuads();
-            trianglesBefore[pool + 1] = trianglesBefore[pool] + mesher.polygonPoolList()[pool].numTriangles();
+            quadsBefore[pool + 1] = quadsBefore[pool] + mesher.pools[pool].numQuads();
+            trianglesBefore[pool + 1] = trianglesBefore[pool] + mesher.pools[pool].numTriangles();
         }
         mesh.quads.resize(quadsBefore[pools]);
         mesh.triangles.resize(trianglesBefore[pools]);
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pools), [&](const auto& range) {
             for (std::size_t pool = range.begin(); pool < range.end(); ++pool) {
-                openvdb::tools::PolygonPool& polygons = mesher.polygonPoolList()[pool];
+                openvdb::tools::PolygonPool& polygons = mesher.pools[pool];
                 for (std::size_t index = 0; index < polygons.numQuads(); ++index) {
                     const openvdb::Vec4I& quad = polygons.quad(index);
                     mesh.quads[quadsBefore[pool] + index] = {quad[0], quad[1], quad[2], quad[3]};
