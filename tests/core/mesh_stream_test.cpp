@@ -330,8 +330,7 @@ TEST_F(MeshStream, ThePlanBoundsWhatEverySlabSamples) {
                 const openvdb::CoordBBox window(openvdb::Coord(x0 - kSlabHalo, full.min().y(), full.min().z()),
                                                 openvdb::Coord(x1 + kSlabHalo - 1, full.max().y(), full.max().z()));
                 StagedProgress staged({}, nullptr);
-                const SampledSurface sampled =
-                    sampleSurface(params, {}, meshMemoryModel(), staged, 0.05, 0.8, &window);
+                const SampledSurface sampled = sampleSurface(params, {}, meshMemoryModel(), staged, 0.05, 0.8, &window);
                 const std::uint64_t planned =
                     samplingEstimate(meshMemoryModel(), slabLeaves(layers, first, end, kHalo), false);
                 EXPECT_LE(sampled.stats.estimatedBytes, planned)
