@@ -312,6 +312,67 @@ TEST_F(MeshStream, ALimitNoSlabFitsIsRefusedBeforeAnySampling) {
     EXPECT_EQ(dqj::test::readFile(path("m.ply")), "previous");
 }
 
+TEST_F(MeshStream, ThePlanBoundsWhatEverySlabSamples) {
+    // The slab plan counts each window's first wave from the classification alone; the sampler,
+    // given the window, must never find more (the counts of a default limit's plan came out
+    // under it once, and its one slab was refused at run time). Every slab of 1, 2 and 5 layers.
+    for (const bool rotated : {false, true}) {
+        Params params = defaultAt(96);
+        if (rotated) params.slice.rotations = {PlaneRotation{2, 4, 30.0}};  // a.j towards b.s
+        const LeafLayers layers = countLeafLayers(params, {}, {});
+        const openvdb::CoordBBox full = bakeIndexBox(params);
+        constexpr std::size_t kHalo = kSlabHalo / 8;
+        std::size_t slabs = 0, exact = 0;
+        for (const std::size_t thickness : {1u, 2u, 5u}) {
+            for (std::size_t first = 0; first < layers.sampled.size(); first += thickness) {
+                const std::size_t end = std::min(layers.sampled.size(), first + thickness);
+                const int x0 = (layers.first + int(first)) * 8, x1 = (layers.first + int(end)) * 8;
+                const openvdb::CoordBBox window(openvdb::Coord(x0 - kSlabHalo, full.min().y(), full.min().z()),
+                                                openvdb::Coord(x1 + kSlabHalo - 1, full.max().y(), full.max().z()));
+                StagedProgress staged({}, nullptr);
+                const SampledSurface sampled = sampleSurface(params, {}, meshMemoryModel(), staged, 0.05, 0.8, &window);
+                const std::uint64_t planned =
+                    samplingEstimate(meshMemoryModel(), slabLeaves(layers, first, end, kHalo), false);
+                EXPECT_LE(sampled.stats.estimatedBytes, planned)
+                    << (rotated ? "rotated: " : "") << "layers " << first << " to " << end;
+                exact += sampled.stats.estimatedBytes == planned;
+                ++slabs;
+            }
+        }
+        EXPECT_GT(exact, 0u) << "the bound is never reached: is it counting the first wave?";
+        EXPECT_GT(slabs, 20u);
+    }
+}
+
+TEST_F(MeshStream, ASlabOverTheLimitWhenSampledIsSplitNotRefused) {
+    // Slabs forced 64 voxels thick under a limit that only thinner ones fit: each is found over
+    // the limit by its sampler (before sampling) and split in two until it fits, and the mesh is
+    // still the one made in one piece.
+    const Params params = defaultAt(128);
+    const Mesh whole = gather(params, 0);
+    const LeafLayers layers = countLeafLayers(params, {}, {});
+    BakeOptions options;
+    options.memoryLimit =
+        samplingEstimate(meshMemoryModel(), slabLeaves(layers, 0, layers.sampled.size(), 0) / 2, false);
+    BakeStats stats;
+    std::size_t parts = 0;
+    const Mesh streamed = gather(params, 64, options, &stats, &parts);
+    EXPECT_GT(stats.slabs, layers.sampled.size() / 8 + 1) << "no slab was split";
+    EXPECT_EQ(parts, stats.slabs);
+    EXPECT_LE(stats.estimatedBytes, options.memoryLimit);
+    expectClosedManifold(streamed, "split slabs");
+    expectSameMesh(streamed, whole, "split slabs");
+    // A slab of one layer over the limit is refused, with the reason.
+    options.memoryLimit = samplingEstimate(meshMemoryModel(), 10, false);
+    try {
+        gather(params, 64, options);
+        FAIL() << "not refused";
+    } catch (const MemoryLimitError& error) {
+        EXPECT_NE(std::string(error.what()).find("even meshed slab by slab: the thinnest slab"), std::string::npos)
+            << error.what();
+    }
+}
+
 TEST_F(MeshStream, AnAdaptiveMeshOverTheLimitIsRefusedWithTheReason) {
     Params params = defaultAt(96);
     BakeStats wholeStats;

@@ -28,13 +28,22 @@ MemoryModel bakeMemoryModel(const BakeSettings& bake) {
     return model;
 }
 
-/// Memory per sampled 8^3 leaf beyond the sampled leaf itself: volumeToMesh's masks and polygon
-/// pools, and the mesh's arrays. Measured on the default fractal (peak RSS minus the 65 MB of a
-/// tiny mesh, over sampled leaves: 3.0 kB at 256^3, 5.6 kB at 512^3) and doubled for headroom.
+/// Memory per leaf of the sampler's first wave (the leaves it checks against the limit; later
+/// waves, inside the set, add about 15 % more) beyond kFloatLeafBytes: the leaf's values, the
+/// later waves, the classification's states, volumeToMesh's masks and polygon pools, the mesh's
+/// arrays, normals and colours, and in slabs the part handed on beside the slab's mesh. Measured
+/// on the default fractal (issue 39; peak RSS from VmHWM, reset before each slab, minus the RSS
+/// before it, over the slab's first wave): slabs at 1024^3 (7 under a 500 MB limit) 2.9 to 4.6 kB,
+/// at 2048^3 (6 under 2 GB) 2.9 to 3.5 kB; in one piece 2.9 kB at 1024^3. The most is a slab
+/// across the middle, where the surface has the most vertices per leaf (39 against 26 on
+/// average). 5.5 kB keeps a margin of 20 % over the most and 80 % over the usual; the fixed part
+/// covers the process and what it keeps between slabs (the seam, the allocator's: up to 85 MB
+/// measured at 2048^3). The model before (10 kB, from 512^3 and doubled) refused 4096^3 under
+/// 2 GB, whose slabs fit.
 MemoryModel meshMemoryModel() {
     MemoryModel model;
     model.fixedBytes = 96.0 * 1024 * 1024;
-    model.bytesPerLeaf = 10.0 * 1024;
+    model.bytesPerLeaf = 5.5 * 1024;
     return model;
 }
 

@@ -21,7 +21,8 @@ struct MemoryModel {
 /// What a bake takes beyond its sampled leaves, by the grids it writes (bakeVdb).
 MemoryModel bakeMemoryModel(const BakeSettings& bake);
 
-/// What a mesh takes beyond its sampled leaves (bakeMesh).
+/// What a mesh, in one piece or one slab at a time, takes beyond its sampled leaves, per leaf of
+/// the sampler's first wave (what the sampler checks and the slab plan bounds: slabLeaves).
 MemoryModel meshMemoryModel();
 
 }  // namespace dqj

@@ -262,31 +262,31 @@ struct Slab {
     double share = 0.0;  // of the work, for progress
 };
 
-/// The estimate of sampling slab [first, end) with its halo: the first wave's leaves of its
-/// layers and halo, and the deferred leaves of the outer layers (sampled there: next to the cut).
+/// The estimate of sampling and meshing slab [first, end) with its halo (slabLeaves,
+/// sparse_sampler.hpp: it bounds the sampler's first wave).
 std::uint64_t slabEstimate(const LeafLayers& layers, std::size_t first, std::size_t end, bool dense) {
-    const std::size_t halo = kSlabHalo / kLayer;
-    const std::size_t lo = first >= halo ? first - halo : 0, hi = std::min(layers.sampled.size(), end + halo);
-    std::uint64_t leaves = 0;
-    for (std::size_t layer = lo; layer < hi; ++layer) leaves += layers.sampled[layer];
-    if (lo > 0) leaves += layers.deferred[lo];
-    if (hi < layers.sampled.size()) leaves += layers.deferred[hi - 1];
-    return samplingEstimate(meshMemoryModel(), leaves, dense);
+    return samplingEstimate(meshMemoryModel(), slabLeaves(layers, first, end, kSlabHalo / kLayer), dense);
 }
 
-/// Refuses when the thinnest slab at `layer` (one layer and its halo) exceeds the limit (with
-/// layers not counted yet as 0, the estimate only grows as they are).
+/// The refusal of a resolution whose thinnest slab at `layer` (one layer and its halo) needs
+/// `estimate`, more than the limit.
+MemoryLimitError thinnestSlabError(const Params& params, const LeafLayers& layers, std::size_t layer,
+                                   const SamplingLimit& limit, std::uint64_t estimate) {
+    const int x = (layers.first + int(layer)) * kLayer;
+    return MemoryLimitError("resolution " + std::to_string(params.bake.resolution) + " does not fit the limit of " +
+                                limit.text() + " even meshed slab by slab: the thinnest slab, the " +
+                                std::to_string(kLayer) + " voxels from x = " + std::to_string(x) + " with " +
+                                std::to_string(kSlabHalo) + " more on either side, needs an estimated " +
+                                formatBytes(estimate) + " or more" + limit.advice(),
+                            estimate, limit.bytes);
+}
+
+/// Refuses when the thinnest slab at `layer` exceeds the limit (with layers not counted yet as
+/// 0, the estimate only grows as they are).
 void checkThinnestSlab(const Params& params, const LeafLayers& layers, std::size_t layer, const SamplingLimit& limit,
                        bool dense) {
     const std::uint64_t thinnest = slabEstimate(layers, layer, layer + 1, dense);
-    if (thinnest <= limit.bytes) return;
-    const int x = (layers.first + int(layer)) * kLayer;
-    throw MemoryLimitError("resolution " + std::to_string(params.bake.resolution) + " does not fit the limit of " +
-                               limit.text() + " even meshed slab by slab: the thinnest slab, the " +
-                               std::to_string(kLayer) + " voxels from x = " + std::to_string(x) + " with " +
-                               std::to_string(kSlabHalo) + " more on either side, needs an estimated " +
-                               formatBytes(thinnest) + " or more" + limit.advice(),
-                           thinnest, limit.bytes);
+    if (thinnest > limit.bytes) throw thinnestSlabError(params, layers, layer, limit, thinnest);
 }
 
 /// The slabs, each as many layers as the limit allows; refuses a layer that cannot fit alone.
@@ -412,7 +412,10 @@ void meshSurface(const Params& params, const BakeOptions& options, const Progres
         throw ParamError("bake.adaptivity", "meshes in slabs need bake.adaptivity 0 and no bake.max_faces");
     }
 
-    // Slab by slab: plan from the classification alone, refuse before sampling if a slab cannot fit.
+    // Slab by slab: plan from the classification alone, refuse before sampling if a slab cannot
+    // fit. The limit is fixed here, for the plan and every slab (the default, half the available
+    // memory, moves as the machine's load does).
+    const SamplingLimit limit = samplingMemoryLimit(options);
     LeafLayers layers;
     std::vector<Slab> slabs;
     if (slabVoxels > 0) {
@@ -423,7 +426,6 @@ void meshSurface(const Params& params, const BakeOptions& options, const Progres
         slabs = evenSlabs(layers, slabVoxels);
     } else {
         StagedProgress planning(within(0.0, 0.05), options.monitor);
-        const SamplingLimit limit = samplingMemoryLimit(options);
         checkPlanFits(params, limit, options.dense);
         // A layer too large even alone is refused as soon as its chunk is counted.
         const std::size_t halo = kSlabHalo / kLayer;
@@ -447,19 +449,35 @@ void meshSurface(const Params& params, const BakeOptions& options, const Progres
     Seam seam;
     std::uint64_t vertices = 0;
     double begin = planned;
-    for (std::size_t index = 0; index < slabs.size(); ++index) {
-        const Slab& slab = slabs[index];
-        const double end = index + 1 == slabs.size() ? 1.0 : begin + slab.share * (1.0 - planned);
-        if (options.monitor) options.monitor->slab = std::uint32_t(index + 1);
+    // The slabs still to make, the next last. The plan bounds each slab's first wave (slabLeaves),
+    // but a slab whose sampler still finds it over the limit (forced thicknesses; a count the plan
+    // missed) is split in two, at run time, rather than refused: only a slab of one layer is.
+    std::vector<Slab> pending(slabs.rbegin(), slabs.rend());
+    std::size_t made = 0;
+    while (!pending.empty()) {
+        const Slab slab = pending.back();
+        pending.pop_back();
+        const double end = pending.empty() ? 1.0 : begin + slab.share * (1.0 - planned);
+        if (options.monitor) options.monitor->slab = std::uint32_t(made + 1);
         StagedProgress staged(within(begin, end), options.monitor);
-        begin = end;
         // The slab's bounds, in voxels and in slice units (open outwards at the ends).
         const int x0 = (layers.first + int(slab.first)) * kLayer, x1 = (layers.first + int(slab.end)) * kLayer;
         const double lo = slab.first == 0 ? -std::numeric_limits<double>::infinity() : x0 * voxel;
         const double hi = slab.end == layers.sampled.size() ? std::numeric_limits<double>::infinity() : x1 * voxel;
         const openvdb::CoordBBox window(openvdb::Coord(x0 - kSlabHalo, full.min().y(), full.min().z()),
                                         openvdb::Coord(x1 + kSlabHalo - 1, full.max().y(), full.max().z()));
-        SampledSurface sampled = sampleSurface(params, options, meshMemoryModel(), staged, 0.05, 0.8, &window);
+        SampledSurface sampled;
+        try {
+            sampled = sampleSurface(params, options, meshMemoryModel(), staged, 0.05, 0.8, &window, &limit);
+        } catch (const MemoryLimitError& error) {
+            if (slab.end - slab.first < 2) throw thinnestSlabError(params, layers, slab.first, limit, error.estimate());
+            const std::size_t middle = slab.first + (slab.end - slab.first) / 2;
+            pending.push_back({middle, slab.end, 0.5 * slab.share});
+            pending.push_back({slab.first, middle, 0.5 * slab.share});
+            if (options.monitor) options.monitor->slabs = std::uint32_t(made + pending.size());
+            continue;
+        }
+        begin = end;
         addStats(stats, sampled.stats);
         Mesh local = meshOfGrid(sampled.grid, 0.0, staged.stage(BakeStage::Meshing, 0.8, 0.9));
         Mesh part = ownedPart(local, lo, hi, vertices, seam);
@@ -472,8 +490,9 @@ void meshSurface(const Params& params, const BakeOptions& options, const Progres
                 "lower the resolution or mesh a smaller region (bake.bounds)");
         sink(std::move(part));
         platform::releaseFreedMemory();
+        ++made;
     }
-    stats.slabs = slabs.size();
+    stats.slabs = made;
     stats.dense = denseVoxels(params);
     stats.voxelSize = voxel;
     finish();

@@ -131,7 +131,7 @@ double largestStretch(Slice slice, bool keepReal, bool keepDual) {
 class Sampler {
 public:
     Sampler(const Params& params, const BakeOptions& options, const MemoryModel& memory, StagedProgress& progress,
-            const CoordBBox* window = nullptr)
+            const CoordBBox* window = nullptr, const SamplingLimit* limit = nullptr)
         : params_(params),
           options_(options),
           memory_(memory),
@@ -153,7 +153,7 @@ public:
             indexBox_.intersect(*window);
             dense_ = std::max<std::uint64_t>(1, std::uint64_t(double(dense_) * double(indexBox_.volume()) / whole));
         }
-        limit_ = samplingMemoryLimit(options);
+        limit_ = limit ? *limit : samplingMemoryLimit(options);
     }
 
     /// Classification alone (no memory check, nothing sampled): the first wave's leaves and the
@@ -571,8 +571,9 @@ double bakeVoxelSize(const Params& params) {
 }
 
 SampledSurface sampleSurface(const Params& params, const BakeOptions& options, const MemoryModel& memory,
-                             StagedProgress& progress, double split, double end, const CoordBBox* window) {
-    Sampler sampler(params, options, memory, progress, window);
+                             StagedProgress& progress, double split, double end, const CoordBBox* window,
+                             const SamplingLimit* limit) {
+    Sampler sampler(params, options, memory, progress, window, limit);
     return sampler.run(split, end);
 }
 
@@ -612,6 +613,17 @@ std::string SamplingLimit::advice() const {
     return processLimited
                ? "; lower the resolution, bake a smaller region (bake.bounds) or raise the process's limit"
                : "; lower the resolution, bake a smaller region (bake.bounds) or raise the limit (--max-memory)";
+}
+
+std::uint64_t slabLeaves(const LeafLayers& layers, std::size_t first, std::size_t end, std::size_t halo) {
+    const std::size_t lo = first >= halo ? first - halo : 0, hi = std::min(layers.sampled.size(), end + halo);
+    std::uint64_t leaves = 0;
+    for (std::size_t layer = lo; layer < hi; ++layer) leaves += layers.sampled[layer];
+    if (!layers.deferred.empty()) {  // none where every leaf is sampled (dense, or thickness forced)
+        if (lo > 0) leaves += layers.deferred[lo];
+        if (hi < layers.sampled.size()) leaves += layers.deferred[hi - 1];
+    }
+    return leaves;
 }
 
 std::uint64_t countLeafLayersBytes(const Params& params) {

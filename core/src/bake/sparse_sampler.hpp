@@ -113,10 +113,13 @@ openvdb::CoordBBox bakeIndexBox(const Params& params);
 /// with -eps unless the surface reaches them), so f is the whole bake's on every leaf a leaf or
 /// more inside the window, bar a pocket of outside inside the set the whole bake misses (above).
 /// Throws MemoryLimitError (before sampling) and Cancelled. Uses progress stages Classifying in
-/// [0, split] and Sampling in [split, end].
+/// [0, split] and Sampling in [split, end]. `limit`: the limit to check against, where the
+/// caller fixed it (a streamed mesh's slabs keep the limit they were planned under; the
+/// default, half the available memory, moves); else samplingMemoryLimit(options).
+struct SamplingLimit;
 SampledSurface sampleSurface(const Params& params, const BakeOptions& options, const MemoryModel& memory,
                              StagedProgress& progress, double split, double end,
-                             const openvdb::CoordBBox* window = nullptr);
+                             const openvdb::CoordBBox* window = nullptr, const SamplingLimit* limit = nullptr);
 
 /// The voxels in the bounds' box: what a dense bake of the whole evaluates (BakeStats::dense).
 std::uint64_t denseVoxels(const Params& params);
@@ -144,6 +147,12 @@ struct LeafLayers {
     std::vector<std::uint64_t> deferred;  ///< leaves inside the set it samples only if the surface reaches them
     std::uint64_t evaluated = 0;          ///< fractal evaluations the classification took
 };
+
+/// The leaves sampleSurface's first wave may sample in the window of layers [first, end) grown
+/// by `halo` layers on either side: the window's first-wave leaves, and the deferred leaves of
+/// its two outer layers (next to the window's cut they join the first wave). A bound, not an
+/// estimate: the window classifies its leaves as the whole bake does (tested).
+std::uint64_t slabLeaves(const LeafLayers& layers, std::size_t first, std::size_t end, std::size_t halo);
 
 /// The most memory countLeafLayers may hold at once, from the resolution alone: a chunk's leaf
 /// lists and states with no leaf of it proven empty (2.5 GB at 16384, 630 MB at 8192).
