@@ -32,8 +32,13 @@ void refuseUnprintable(const BakeFlags& flags, const std::string& path, const Pr
 void printPrintStats(const PrintReport& report) {
     std::cout << "print_closed " << report.closed() << "\nprint_boundary_edges " << report.boundaryEdges
               << "\nprint_edge_manifold " << report.manifold() << "\nprint_nonmanifold_edges "
-              << report.nonManifoldEdges << "\nprint_islands " << report.islands.size() << "\nprint_dropped_islands "
-              << report.droppedIslands << "\nprint_dropped_faces " << report.droppedFaces << "\n";
+              << report.nonManifoldEdges << "\n";
+    if (!report.islandsCounted) {  // streamed: the edges alone
+        std::cout << "print_ok " << report.failure().empty() << "\n";
+        return;
+    }
+    std::cout << "print_islands " << report.islands.size() << "\nprint_dropped_islands " << report.droppedIslands
+              << "\nprint_dropped_faces " << report.droppedFaces << "\n";
     for (std::size_t index = 0; index < std::min<std::size_t>(5, report.islands.size()); ++index) {
         const PrintIsland& island = report.islands[index];
         const glm::dvec3 size = island.max - island.min;
@@ -90,8 +95,9 @@ int runMesh(const BakeFlags& flags) {
             ProgressBar bar(frames.size() > 1 ? "meshing frame " + std::to_string(frames[index]) : "meshing",
                             flags.quiet);
             try {
-                if (check) {
-                    // Checked whole before it is written: refused, with nothing written, when unprintable.
+                if (flags.printCheckAsked()) {
+                    // Islands and walls: checked whole before it is written; refused, with nothing
+                    // written, when unprintable.
                     const ProgressCallback progress = bakeProgress(bar, monitor);
                     const Mesh whole = meshForPrint(perFrame[index], options, print, progress, stats, report, scale);
                     if (progress && !progress(1.0)) throw Cancelled();
@@ -102,8 +108,16 @@ int runMesh(const BakeFlags& flags) {
                 } else {
                     // Written as it is made, slab by slab where the memory limit asks for it; the file
                     // appears only complete (a signal in the last moments, too, leaves nothing).
-                    mesh =
-                        bakeMeshFile(perFrame[index], paths[index], options, bakeProgress(bar, monitor), &stats, scale);
+                    // .stl and .3mf: closed and edge-manifold checked as the slabs come, before it is published.
+                    std::function<void(const PrintReport&)> approve;
+                    if (check)
+                        approve = [&](const PrintReport& edges) {
+                            report = edges;
+                            bar.finish();
+                            refuseUnprintable(flags, paths[index], report);
+                        };
+                    mesh = bakeMeshFileChecked(perFrame[index], paths[index], options, bakeProgress(bar, monitor),
+                                               &stats, scale, approve);
                 }
             } catch (const Cancelled&) {
                 bar.finish();

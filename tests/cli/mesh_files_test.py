@@ -43,7 +43,13 @@ def mesh_stats(cli, path, arguments):
     done = run(cli, "-f", "-q", "--stats", *arguments, "-o", path)
     if done.returncode != 0:
         raise SystemExit("dqjulia mesh %s failed: %s" % (" ".join(arguments), done.stderr))
-    return {key: float(value) for key, value in (line.split(None, 1) for line in done.stdout.splitlines())}
+    stats = {}
+    for key, value in (line.split(None, 1) for line in done.stdout.splitlines()):
+        try:
+            stats[key] = float(value)
+        except ValueError:  # a vector (print_island_1_size): not needed here
+            stats[key] = value
+    return stats
 
 
 def edge_problems(faces):

@@ -1,4 +1,5 @@
-// `dqjulia mesh`'s print check as a user meets it: the ball's report (one closed island, its
+// `dqjulia mesh`'s print check as a user meets it: an STL or 3MF checked closed and
+// edge-manifold as its slabs are written; the ball's full report (one closed island, its
 // size and volume, its diameter as its thinnest wall) in the file's units; an STL refused with
 // the reason named and nothing written unless --allow-unprintable; a PLY written with a warning;
 // islands dropped by --min-island and --largest-only; a mesh too large for one piece refused.
@@ -31,8 +32,25 @@ const std::string kBall =
 constexpr double kVoxel = 0.075;
 constexpr double kPi = std::numbers::pi;
 
-TEST_F(PrintCli, TheBallIsPrintableAndReported) {
+TEST_F(PrintCli, AnStlIsCheckedClosedAndManifoldAsItIsStreamed) {
     const Outcome ok = run(kBall + "--stats -o '" + path("ball.stl") + "'");
+    ASSERT_EQ(ok.exitCode, 0) << ok.err;
+    EXPECT_EQ(statValue(ok.out, "print_closed"), 1.0);
+    EXPECT_EQ(statValue(ok.out, "print_edge_manifold"), 1.0);
+    EXPECT_EQ(statValue(ok.out, "print_ok"), 1.0);
+    EXPECT_EQ(ok.out.find("print_islands"), std::string::npos) << ok.out;  // asked for with --min-island
+    EXPECT_NE(ok.err.find("print check: closed, edge-manifold; "), std::string::npos) << ok.err;
+    // In slabs (the limit too small for one piece), checked all the same.
+    const Outcome slabs = run("mesh -r 256 --no-colors --max-memory 120M --stats -o '" + path("big.3mf") + "'");
+    ASSERT_EQ(slabs.exitCode, 0) << slabs.err;
+    EXPECT_GT(statValue(slabs.out, "slabs"), 1.0);
+    EXPECT_EQ(statValue(slabs.out, "print_closed"), 1.0);
+    EXPECT_EQ(statValue(slabs.out, "print_edge_manifold"), 1.0);
+    EXPECT_EQ(statValue(slabs.out, "print_ok"), 1.0);
+}
+
+TEST_F(PrintCli, TheBallIsPrintableAndReported) {
+    const Outcome ok = run(kBall + "--min-island 1 --stats -o '" + path("ball.stl") + "'");
     ASSERT_EQ(ok.exitCode, 0) << ok.err;
     EXPECT_EQ(statValue(ok.out, "print_closed"), 1.0);
     EXPECT_EQ(statValue(ok.out, "print_edge_manifold"), 1.0);
@@ -84,7 +102,7 @@ TEST_F(PrintCli, TheCheckIsInTheFilesUnits) {
 
 TEST_F(PrintCli, IslandsAreDroppedOnRequest) {
     const std::string fractal = "mesh -r 128 --no-colors --stats ";  // 5 islands
-    const Outcome all = run(fractal + "--allow-unprintable -o '" + path("all.stl") + "'");
+    const Outcome all = run(fractal + "--min-island 1 --allow-unprintable -o '" + path("all.stl") + "'");
     ASSERT_EQ(all.exitCode, 0) << all.err;
     const double islands = statValue(all.out, "print_islands"), faces = statValue(all.out, "faces");
     ASSERT_GT(islands, 2.0) << all.err;  // the default Julia set breaks into islands
@@ -115,7 +133,7 @@ TEST_F(PrintCli, IslandsAreDroppedOnRequest) {
 }
 
 TEST_F(PrintCli, AMeshForSlabsIsRefusedForTheCheckBeforeWork) {
-    const Outcome refused = run("mesh -r 256 --max-memory 40M -o '" + path("big.stl") + "'");
+    const Outcome refused = run("mesh -r 256 --max-memory 120M --largest-only -o '" + path("big.stl") + "'");
     EXPECT_EQ(refused.exitCode, 2) << refused.err;
     EXPECT_NE(refused.err.find("needs the mesh in one piece"), std::string::npos) << refused.err;
     EXPECT_TRUE(files().empty());

@@ -10,6 +10,7 @@
 
 #include <glm/geometric.hpp>
 #include <glm/gtc/quaternion.hpp>
+#include "bake/mesh_stream.hpp"
 #include "bake/print_check.hpp"
 #include "dqjulia/mesh.hpp"
 
@@ -270,6 +271,56 @@ TEST(PrintCheck, IslandsAreDroppedBySizeOrAllButTheLargest) {
                 << error.what();
         }
     }
+}
+
+TEST(PrintCheck, EdgesCountedPartByPartEqualTheWholeMesh) {
+    // Two parts as the mesher streams them: the second's faces name its own vertices and the
+    // first's (a fin on the first box's edge 1-3), never older ones.
+    Mesh first, second;
+    addBox(first, glm::dvec3(0.0), glm::dvec3(1.0));
+    first.quads.erase(first.quads.begin() + 1);  // an open box: 4 boundary edges
+    addBox(second, glm::dvec3(2.0), glm::dvec3(3.0));
+    for (auto& quad : second.quads)
+        for (std::uint32_t& vertex : quad) vertex += 8;  // after the first part's 8 vertices
+    second.positions.emplace_back(2.0f, 0.0f, -1.0f);
+    second.positions.emplace_back(2.0f, 1.0f, -1.0f);
+    second.normals.resize(second.positions.size());
+    second.quads.push_back({1, 16, 17, 3});  // the fin: 1 non-manifold edge, 3 boundary edges more
+
+    Mesh whole = first;
+    whole.positions.insert(whole.positions.end(), second.positions.begin(), second.positions.end());
+    whole.normals.insert(whole.normals.end(), second.normals.begin(), second.normals.end());
+    whole.quads.insert(whole.quads.end(), second.quads.begin(), second.quads.end());
+    const PrintReport expected = check(whole, 0.0);
+    EdgeTally tally;
+    tally.add(first);
+    tally.add(second);
+    const PrintReport& streamed = tally.finish();
+    EXPECT_FALSE(streamed.islandsCounted);
+    EXPECT_EQ(streamed.faces, whole.quads.size());
+    EXPECT_EQ(streamed.edges, expected.edges);
+    EXPECT_EQ(streamed.boundaryEdges, expected.boundaryEdges);
+    EXPECT_EQ(streamed.nonManifoldEdges, expected.nonManifoldEdges);
+    EXPECT_EQ(streamed.boundaryEdges, 7u);
+    EXPECT_EQ(streamed.nonManifoldEdges, 1u);
+}
+
+TEST(PrintCheck, ASlabbedMeshIsClosedAndManifoldPartByPart) {
+    Params params;  // the default fractal, meshed in 16-voxel slabs
+    params.bake.resolution = 96;
+    params.bake.meshColors = false;
+    EdgeTally tally;
+    BakeStats stats;
+    meshSurface(params, {}, {}, [&](Mesh&& part) { tally.add(part); }, stats, 16);
+    EXPECT_GT(stats.slabs, 3u);
+    const PrintReport& streamed = tally.finish();
+    const Mesh onePiece = bakeMesh(params);
+    const PrintReport expected = check(onePiece, 0.0);
+    EXPECT_EQ(streamed.faces, onePiece.quads.size() + onePiece.triangles.size());
+    EXPECT_EQ(streamed.edges, expected.edges);
+    EXPECT_EQ(streamed.boundaryEdges, 0u);
+    EXPECT_EQ(streamed.nonManifoldEdges, 0u);
+    EXPECT_EQ(streamed.failure(), "");
 }
 
 TEST(PrintCheck, TheBallIsOneClosedIslandAsWideAsItsWall) {

@@ -4,6 +4,7 @@
 
 #include "bake/mesh_file.hpp"
 #include "bake/mesh_stream.hpp"
+#include "bake/print_check.hpp"
 
 namespace dqj {
 
@@ -44,16 +45,8 @@ Mesh bakeMesh(const Params& params, const BakeOptions& options, const ProgressCa
 }
 
 MeshCounts bakeMeshFile(const Params& params, const std::string& path, const BakeOptions& options,
-                        const ProgressCallback& progress, BakeStats* statsOut, const MeshScale& scale) {
-    validate(params);
-    MeshFile file(path, params.bake.meshColors, options.existing, scale);  // fails now, before the work
-    BakeStats stats;
-    meshSurface(
-        params, options, progress, [&file](Mesh&& part) { file.add(part); }, stats);
-    if (progress && !progress(1.0)) throw Cancelled();  // a signal in the last moments: publish nothing
-    file.commit();
-    if (statsOut) *statsOut = stats;
-    return file.counts();
+                        const ProgressCallback& progress, BakeStats* stats, const MeshScale& scale) {
+    return bakeMeshFileChecked(params, path, options, progress, stats, scale, {});
 }
 
 void writeMesh(const Mesh& mesh, const std::string& path, Existing existing, const MeshScale& scale) {

@@ -17,6 +17,7 @@
 #include "bake/level_set.hpp"
 #include "bake/mesh_stream.hpp"
 #include "bake/sparse_sampler.hpp"
+#include "bake/mesh_file.hpp"
 #include "files/atomic_file.hpp"
 
 namespace dqj {
@@ -51,30 +52,45 @@ std::vector<std::uint64_t> islandFaces(const Mesh& mesh, const std::vector<std::
     return faces;
 }
 
-/// Counts the edges and marks the islands with a boundary edge open.
-void checkEdges(const Mesh& mesh, const std::vector<std::uint32_t>& labels, std::vector<bool>& open,
-                PrintReport& report) {
-    std::vector<std::uint64_t> edges;
-    edges.reserve(3 * mesh.triangles.size() + 4 * mesh.quads.size());
+/// Appends the edges of `mesh`'s faces, one key a face side: lesser vertex << 32 | greater.
+void appendEdges(const Mesh& mesh, std::vector<std::uint64_t>& edges) {
+    edges.reserve(edges.size() + 3 * mesh.triangles.size() + 4 * mesh.quads.size());
     forEachFace(mesh, [&](const std::uint32_t* corners, int count) {
         for (int corner = 0; corner < count; ++corner) {
             const std::uint64_t a = corners[corner], b = corners[(corner + 1) % count];
             edges.push_back(std::min(a, b) << 32 | std::max(a, b));
         }
     });
+}
+
+/// Sorts `edges` and calls visit(key, faces) for each distinct edge, with the faces it is in.
+template <typename Visit>
+void forEachEdge(std::vector<std::uint64_t>& edges, Visit visit) {
     tbb::parallel_sort(edges.begin(), edges.end());
     for (std::size_t first = 0; first < edges.size();) {
         std::size_t end = first + 1;
         while (end < edges.size() && edges[end] == edges[first]) ++end;
-        ++report.edges;
-        if (end - first == 1) {
-            ++report.boundaryEdges;
-            open[labels[std::uint32_t(edges[first] >> 32)]] = true;
-        } else if (end - first > 2) {
-            ++report.nonManifoldEdges;
-        }
+        visit(edges[first], end - first);
         first = end;
     }
+}
+
+/// Counts an edge in `faces` faces into the report.
+void countEdge(std::size_t faces, PrintReport& report) {
+    ++report.edges;
+    if (faces == 1) ++report.boundaryEdges;
+    if (faces > 2) ++report.nonManifoldEdges;
+}
+
+/// Counts the edges and marks the islands with a boundary edge open.
+void checkEdges(const Mesh& mesh, const std::vector<std::uint32_t>& labels, std::vector<bool>& open,
+                PrintReport& report) {
+    std::vector<std::uint64_t> edges;
+    appendEdges(mesh, edges);
+    forEachEdge(edges, [&](std::uint64_t edge, std::size_t faces) {
+        countEdge(faces, report);
+        if (faces == 1) open[labels[std::uint32_t(edge >> 32)]] = true;
+    });
 }
 
 /// The mesh for meshToVolume (its MeshDataAdapter): triangles, then quads, in index space.
@@ -233,6 +249,8 @@ void checkPrint(const Mesh& mesh, const PrintOptions& options, PrintReport& repo
         if (progress && !progress(fraction)) throw Cancelled();
     };
     report.minWall = options.minWall;
+    report.islandsCounted = true;
+    report.faces = mesh.quads.size() + mesh.triangles.size();
     std::uint32_t count = 0;
     const std::vector<std::uint32_t> labels = vertexIslands(mesh, count);
     const std::vector<std::uint64_t> faces = islandFaces(mesh, labels, count);
@@ -290,7 +308,7 @@ void checkPrint(const Mesh& mesh, const PrintOptions& options, PrintReport& repo
 
 std::string PrintReport::failure() const {
     std::vector<std::string> reasons;
-    if (islands.empty()) reasons.emplace_back("the mesh has no faces");
+    if (faces == 0) reasons.emplace_back("the mesh has no faces");
     if (!closed()) reasons.push_back("it is not closed: " + std::to_string(boundaryEdges) + " boundary edges (holes)");
     if (!manifold())
         reasons.push_back("it is not edge-manifold: " + std::to_string(nonManifoldEdges) +
@@ -312,7 +330,13 @@ std::string printReportText(const PrintReport& report) {
          << (report.manifold()
                  ? "edge-manifold"
                  : "not edge-manifold (" + std::to_string(report.nonManifoldEdges) + " edges in more than two faces)")
-         << "; " << report.islands.size() << (report.islands.size() == 1 ? " island" : " islands") << ", " << faces
+         << "; ";
+    if (!report.islandsCounted) {  // EdgeTally's report
+        text << report.faces << " faces (islands and walls are measured with --min-island, --largest-only or "
+             << "--min-wall)\n";
+        return text.str();
+    }
+    text << report.islands.size() << (report.islands.size() == 1 ? " island" : " islands") << ", " << faces
          << " faces";
     if (report.droppedIslands > 0)
         text << " (" << report.droppedIslands << " dropped, " << report.droppedFaces << " faces)";
@@ -345,6 +369,50 @@ std::string printReportText(const PrintReport& report) {
         text << "\n";
     }
     return text.str();
+}
+
+void EdgeTally::add(const Mesh& part) {
+    const std::uint64_t first = vertices_;  // this part's first vertex
+    vertices_ += part.positions.size();
+    appendEdges(part, open_);
+    // The next part's faces name only its own vertices and this part's (mesh_stream.hpp): an
+    // edge with a vertex before this part has all its faces now.
+    std::vector<std::uint64_t> still;
+    forEachEdge(open_, [&](std::uint64_t edge, std::size_t faces) {
+        if (edge >> 32 >= first)
+            still.insert(still.end(), faces, edge);
+        else
+            countEdge(faces, report_);
+    });
+    open_ = std::move(still);
+    report_.faces += part.quads.size() + part.triangles.size();
+}
+
+const PrintReport& EdgeTally::finish() {
+    forEachEdge(open_, [&](std::uint64_t, std::size_t faces) { countEdge(faces, report_); });
+    open_ = {};
+    return report_;
+}
+
+MeshCounts bakeMeshFileChecked(const Params& params, const std::string& path, const BakeOptions& options,
+                               const ProgressCallback& progress, BakeStats* statsOut, const MeshScale& scale,
+                               const std::function<void(const PrintReport&)>& approve) {
+    validate(params);
+    MeshFile file(path, params.bake.meshColors, options.existing, scale);  // fails now, before the work
+    EdgeTally edges;
+    BakeStats stats;
+    meshSurface(
+        params, options, progress,
+        [&](Mesh&& part) {
+            if (approve) edges.add(part);
+            file.add(part);
+        },
+        stats);
+    if (progress && !progress(1.0)) throw Cancelled();  // a signal in the last moments: publish nothing
+    if (approve) approve(edges.finish());               // may throw: nothing is published
+    file.commit();
+    if (statsOut) *statsOut = stats;
+    return file.counts();
 }
 
 Mesh meshForPrint(const Params& params, const BakeOptions& options, PrintOptions print,

@@ -24,6 +24,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -60,9 +61,11 @@ struct PrintOptions {
 constexpr double kDefaultWallVoxels = 12.0;
 
 struct PrintReport {
+    std::uint64_t faces = 0;             ///< EdgeTally's: the faces seen (checkPrint counts them in islands)
     std::uint64_t edges = 0;
     std::uint64_t boundaryEdges = 0;     ///< in one face
     std::uint64_t nonManifoldEdges = 0;  ///< in three or more faces
+    bool islandsCounted = false;         ///< checkPrint: islands and walls; EdgeTally: edges only
     std::vector<PrintIsland> islands;    ///< those kept, most faces first
     std::uint64_t droppedIslands = 0;
     std::uint64_t droppedFaces = 0;
@@ -96,6 +99,30 @@ void checkPrint(const Mesh& mesh, const PrintOptions& options, PrintReport& repo
 
 /// The report as stderr shows it: a few lines, the largest islands first.
 std::string printReportText(const PrintReport& report);
+
+/// The edges of a mesh that comes part by part (a MeshPartSink's parts, mesh_stream.hpp), counted
+/// in a part's memory: an edge is settled once no later part can name both its vertices (a part's
+/// faces name only its own vertices and the part's before), so only the last part's edges are
+/// held (8 bytes a face side). Whether a streamed mesh is closed and edge-manifold, without
+/// holding it whole; islands and walls need the mesh whole (checkPrint).
+class EdgeTally {
+public:
+    void add(const Mesh& part);
+    /// The report: faces, edges, boundaryEdges, nonManifoldEdges (islandsCounted false).
+    const PrintReport& finish();
+
+private:
+    std::vector<std::uint64_t> open_;  // the edges the next part may still reach, a key a face side
+    std::uint64_t vertices_ = 0;
+    PrintReport report_;
+};
+
+/// bakeMeshFile, and with `approve` the mesh's edges counted as its parts are written (EdgeTally):
+/// `approve(report)` runs before the file is published and may throw, which publishes nothing.
+/// Memory and time as bakeMeshFile's, plus a part's edges.
+MeshCounts bakeMeshFileChecked(const Params& params, const std::string& path, const BakeOptions& options,
+                               const ProgressCallback& progress, BakeStats* stats, const MeshScale& scale,
+                               const std::function<void(const PrintReport&)>& approve);
 
 /// Meshes `params` in one piece like bakeMesh, drops islands and checks the rest (options.voxel
 /// 0: the bake's voxel), in the units of a file written with `scale` (writeMesh: with a size, the
