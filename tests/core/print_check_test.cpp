@@ -311,7 +311,8 @@ TEST(PrintCheck, ASlabbedMeshIsClosedAndManifoldPartByPart) {
     params.bake.meshColors = false;
     EdgeTally tally;
     BakeStats stats;
-    meshSurface(params, {}, {}, [&](Mesh&& part) { tally.add(part); }, stats, 16);
+    meshSurface(
+        params, {}, {}, [&](Mesh&& part) { tally.add(part); }, stats, 16);
     EXPECT_GT(stats.slabs, 3u);
     const PrintReport& streamed = tally.finish();
     const Mesh onePiece = bakeMesh(params);

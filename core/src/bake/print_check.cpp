@@ -336,8 +336,7 @@ std::string printReportText(const PrintReport& report) {
              << "--min-wall)\n";
         return text.str();
     }
-    text << report.islands.size() << (report.islands.size() == 1 ? " island" : " islands") << ", " << faces
-         << " faces";
+    text << report.islands.size() << (report.islands.size() == 1 ? " island" : " islands") << ", " << faces << " faces";
     if (report.droppedIslands > 0)
         text << " (" << report.droppedIslands << " dropped, " << report.droppedFaces << " faces)";
     text << "\n";

@@ -61,7 +61,7 @@ struct PrintOptions {
 constexpr double kDefaultWallVoxels = 12.0;
 
 struct PrintReport {
-    std::uint64_t faces = 0;             ///< EdgeTally's: the faces seen (checkPrint counts them in islands)
+    std::uint64_t faces = 0;  ///< EdgeTally's: the faces seen (checkPrint counts them in islands)
     std::uint64_t edges = 0;
     std::uint64_t boundaryEdges = 0;     ///< in one face
     std::uint64_t nonManifoldEdges = 0;  ///< in three or more faces
