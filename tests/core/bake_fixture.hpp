@@ -11,6 +11,7 @@
 #include <openvdb/io/File.h>
 #include <openvdb/openvdb.h>
 
+#include "dqjulia/params.hpp"
 #include "test_support.hpp"
 
 namespace dqj::test {
@@ -21,6 +22,23 @@ class BakeFolder : public ScratchFolder {
 public:
     static void SetUpTestSuite() { openvdb::initialize(); }
 };
+
+/// The default fractal baked at `resolution` voxels across.
+inline Params defaultAt(int resolution) {
+    Params params;
+    params.bake.resolution = resolution;
+    return params;
+}
+
+/// c = 0 and bailout 4: the unit ball, in the box [-1.5, 1.5]^3 at `resolution`, no colours.
+inline Params ballAt(int resolution) {
+    Params params = defaultAt(resolution);
+    params.fractal.c = DualQuat{};
+    params.fractal.bailout = 4.0;
+    params.bake.bounds = Box{glm::dvec3(-1.5), glm::dvec3(1.5)};
+    params.bake.meshColors = false;
+    return params;
+}
 
 /// A VDB file read back with OpenVDB: its grids by name and its file metadata.
 struct VdbFile {

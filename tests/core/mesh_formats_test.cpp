@@ -26,11 +26,7 @@ namespace {
 
 using MeshFormats = dqj::test::BakeFolder;
 
-Params defaultAt(int resolution) {
-    Params params;
-    params.bake.resolution = resolution;
-    return params;
-}
+using dqj::test::defaultAt;
 
 struct StlTriangle {
     glm::vec3 normal;

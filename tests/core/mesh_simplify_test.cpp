@@ -21,19 +21,12 @@ namespace {
 using MeshSimplify = dqj::test::BakeFolder;
 
 Params fractalAt(int resolution) {
-    Params params;
-    params.bake.resolution = resolution;
+    Params params = dqj::test::defaultAt(resolution);
     params.bake.meshColors = false;
     return params;
 }
 
-Params ballAt(int resolution) {
-    Params params = fractalAt(resolution);
-    params.fractal.c = DualQuat{};
-    params.fractal.bailout = 4.0;
-    params.bake.bounds = Box{glm::dvec3(-1.5), glm::dvec3(1.5)};
-    return params;
-}
+using dqj::test::ballAt;
 
 /// A flat square of n x n quads in the plane z = height, unit spacing.
 Mesh plane(int n, float height) {

@@ -30,11 +30,7 @@ namespace {
 
 using MeshStream = dqj::test::BakeFolder;
 
-Params defaultAt(int resolution) {
-    Params params;
-    params.bake.resolution = resolution;
-    return params;
-}
+using dqj::test::defaultAt;
 
 /// A mesh gathered from meshSurface's parts, checking as they come that each part's faces name
 /// only vertices of it and the parts before it.
@@ -166,12 +162,7 @@ TEST_F(MeshStream, SlabsOfAnyThicknessGiveTheMeshMadeInOnePiece) {
 }
 
 TEST_F(MeshStream, TheBallStreamedIsAClosedSphere) {
-    Params params;
-    params.fractal.c = DualQuat{};
-    params.fractal.bailout = 4.0;
-    params.bake.resolution = 40;
-    params.bake.bounds = Box{glm::dvec3(-1.5), glm::dvec3(1.5)};
-    params.bake.meshColors = false;
+    const Params params = dqj::test::ballAt(40);
     const Mesh whole = gather(params, 0);
     const Mesh streamed = gather(params, 8);
     expectClosedManifold(streamed, "ball");

@@ -12,6 +12,7 @@
 #include <glm/gtc/quaternion.hpp>
 #include "bake/mesh_stream.hpp"
 #include "bake/print_check.hpp"
+#include "bake_fixture.hpp"
 #include "dqjulia/mesh.hpp"
 
 using namespace dqj;
@@ -306,8 +307,7 @@ TEST(PrintCheck, EdgesCountedPartByPartEqualTheWholeMesh) {
 }
 
 TEST(PrintCheck, ASlabbedMeshIsClosedAndManifoldPartByPart) {
-    Params params;  // the default fractal, meshed in 16-voxel slabs
-    params.bake.resolution = 96;
+    Params params = dqj::test::defaultAt(96);  // meshed in 16-voxel slabs
     params.bake.meshColors = false;
     EdgeTally tally;
     BakeStats stats;
@@ -325,12 +325,7 @@ TEST(PrintCheck, ASlabbedMeshIsClosedAndManifoldPartByPart) {
 }
 
 TEST(PrintCheck, TheBallIsOneClosedIslandAsWideAsItsWall) {
-    Params params;
-    params.fractal.c = DualQuat{};
-    params.fractal.bailout = 4.0;
-    params.bake.resolution = 60;
-    params.bake.bounds = Box{glm::dvec3(-1.5), glm::dvec3(1.5)};
-    params.bake.meshColors = false;
+    const Params params = dqj::test::ballAt(60);
     PrintOptions options;
     options.minWall = 2.5;
     BakeStats stats;

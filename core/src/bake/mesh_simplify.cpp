@@ -149,9 +149,9 @@ MeshDeviation meshDeviation(const Mesh& reference, const Mesh& mesh, double voxe
     const TriangleCells cells(reference, float(kCellVoxels * voxel));
     tbb::combinable<double> vertices([] { return 0.0; }), samples([] { return 0.0; });
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, mesh.positions.size()), [&](const auto& range) {
-        double& far = vertices.local();
+        double& farthest = vertices.local();
         for (std::size_t index = range.begin(); index < range.end(); ++index)
-            far = std::max(far, double(cells.distance(mesh.positions[index])));
+            farthest = std::max(farthest, double(cells.distance(mesh.positions[index])));
     });
     const std::vector<Triangle> triangles = trianglesOf(mesh);
     static constexpr float kSix = 1.0f / 6.0f, kThird = 1.0f / 3.0f;
@@ -163,13 +163,13 @@ MeshDeviation meshDeviation(const Mesh& reference, const Mesh& mesh, double voxe
                                                                    {kSix, 4 * kSix, kSix},
                                                                    {kSix, kSix, 4 * kSix}}};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangles.size()), [&](const auto& range) {
-        double& far = samples.local();
+        double& farthest = samples.local();
         for (std::size_t index = range.begin(); index < range.end(); ++index) {
             const Triangle& t = triangles[index];
             for (const auto& w : kWeights) {
                 const glm::vec3 p =
                     w[0] * mesh.positions[t[0]] + w[1] * mesh.positions[t[1]] + w[2] * mesh.positions[t[2]];
-                far = std::max(far, double(cells.distance(p)));
+                farthest = std::max(farthest, double(cells.distance(p)));
             }
         }
     });
