@@ -64,6 +64,7 @@ protected:
         return traits_type::not_eof(ch);
     }
     std::streamsize xsputn(const char* data, std::streamsize count) override {
+        if (count <= 0) return 0;  // an empty write, whose data may be null (an empty vector's)
         if (count <= epptr() - pptr()) {
             std::memcpy(pptr(), data, std::size_t(count));
             pbump(int(count));
