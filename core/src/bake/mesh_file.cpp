@@ -252,6 +252,7 @@ Mesh readRawPart(const char* at) {
     Mesh part;
     auto take = [&](auto& values, std::uint64_t count) {
         values.resize(count);
+        if (count == 0) return;  // data() may be null, which memcpy must not get
         std::memcpy(values.data(), at, count * sizeof(values[0]));
         at += count * sizeof(values[0]);
     };
