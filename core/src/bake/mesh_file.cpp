@@ -305,6 +305,13 @@ void checkMeshPath(const std::string& path) {
         throw ParamError("output.path", "'" + inputExcerpt(path) + "' must end in .ply, .obj, .stl or .3mf");
 }
 
+MeshPlacement meshPlacement(const MeshScale& scale, const glm::dvec3& least, const glm::dvec3& most) {
+    const glm::dvec3 sides = most - least;
+    const double largest = std::max({sides.x, sides.y, sides.z});
+    if (!scale.size || !(largest > 0.0)) return {};
+    return {least, *scale.size / largest};
+}
+
 MeshFile::MeshFile(const std::string& path, bool colors, Existing existing, const MeshScale& scale)
     : colors_((checkMeshPath(path), checkMeshScale(scale), colors)),
       scale_(scale),
@@ -358,13 +365,9 @@ void MeshFile::write(const Mesh& part) {
 
 void MeshFile::commit() {
     if (parts_) {
-        // The mesh's largest side becomes the size; its least corner the origin.
-        const glm::dvec3 sides = most_ - least_;
-        const double largest = std::max({sides.x, sides.y, sides.z});
-        if (largest > 0.0) {
-            origin_ = least_;
-            factor_ = *scale_.size / largest;
-        }
+        const MeshPlacement placement = meshPlacement(scale_, least_, most_);
+        origin_ = placement.origin;
+        factor_ = placement.factor;
         std::vector<char> pending;  // the bytes of the part being read back
         parts_->readBack([&](const char* data, std::size_t size) {
             pending.insert(pending.end(), data, data + size);

@@ -51,6 +51,15 @@ public:
     virtual void finish(const MeshCounts& counts) = 0;
 };
 
+/// Where a mesh written with `scale` is placed: output = (position - origin) * factor. With a
+/// size, its largest side (of the bounds `least` to `most`) becomes the size and its least corner
+/// 0; without one, or for a mesh with no extent, it stays as it is.
+struct MeshPlacement {
+    glm::dvec3 origin{0.0};
+    double factor = 1.0;
+};
+MeshPlacement meshPlacement(const MeshScale& scale, const glm::dvec3& least, const glm::dvec3& most);
+
 class MeshFile {
 public:
     /// Opens the temporary files beside `path` (.ply, .obj, .stl or .3mf, any case: else ParamError,

@@ -441,9 +441,8 @@ Mesh meshForPrint(const Params& params, const BakeOptions& options, PrintOptions
         glm::dvec3 least(mesh.positions[0]), most(mesh.positions[0]);
         for (const glm::vec3& p : mesh.positions)
             least = glm::min(least, glm::dvec3(p)), most = glm::max(most, glm::dvec3(p));
-        const glm::dvec3 sides = most - least;
-        const double largest = std::max({sides.x, sides.y, sides.z});
-        if (largest > 0.0) print.scale = *scale.size / largest, print.origin = least;
+        const MeshPlacement placement = meshPlacement(scale, least, most);
+        print.scale = placement.factor, print.origin = placement.origin;
     }
     checkPrint(mesh, print, report, within(0.85, 1.0));
     return mesh;
